@@ -1,0 +1,129 @@
+//! `sylva`: grow trees and move them in the wind.
+//!
+//! With no arguments, runs the main job on the built-in default scene. Until the renderer
+//! lands that is `sylva generate` on the default species.
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::time::Instant;
+use sylva_core::export::{ObjOptions, write_obj};
+use sylva_core::species::{DEFAULT_SPECIES, PRESETS, PresetKind, SpeciesSource};
+use sylva_core::{Limits, Tree};
+
+#[derive(Parser, Debug)]
+#[command(name = "sylva", version, about = "Grow trees and move them in the wind, on the CPU and the GPU.")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Generate a tree, print a summary and write a static OBJ mesh.
+    Generate(GenerateArgs),
+    /// List the species and grammars that ship with Sylva.
+    Presets,
+}
+
+#[derive(clap::Args, Debug)]
+struct GenerateArgs {
+    /// A preset name (see `sylva presets`), a Weber–Penn TOML file or an L-system grammar file.
+    #[arg(long, short, default_value = DEFAULT_SPECIES)]
+    species: String,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Derivation steps of an L-system (overrides the grammar's `iterations`).
+    #[arg(long)]
+    iterations: Option<u32>,
+    /// Output OBJ file (default: out/<species>.obj); `-` writes none.
+    #[arg(long, short)]
+    out: Option<PathBuf>,
+    /// Sides of each branch tube in the OBJ.
+    #[arg(long, default_value_t = 6)]
+    sides: u32,
+    /// Stop with an error before a tree exceeds this many segments.
+    #[arg(long, default_value_t = Limits::default().max_segments)]
+    max_segments: usize,
+    /// Stop with an error before a tree exceeds this many leaves.
+    #[arg(long, default_value_t = Limits::default().max_leaves)]
+    max_leaves: usize,
+    /// Worker threads (default: all cores). The tree is identical for any count.
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+fn main() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        None => match Cli::parse_from(["sylva", "generate"]).command {
+            Some(Command::Generate(args)) => generate(args),
+            _ => unreachable!("`generate` parses as the generate command"),
+        },
+        Some(Command::Generate(args)) => generate(args),
+        Some(Command::Presets) => {
+            presets();
+            Ok(())
+        }
+    }
+}
+
+fn presets() {
+    println!("{:<18} {:<9} {:<36} description", "name", "kind", "file");
+    for p in PRESETS {
+        let kind = match p.kind {
+            PresetKind::Species => "species",
+            PresetKind::Grammar => "grammar",
+        };
+        let desc = SpeciesSource::from_preset(p).map(|s| s.name().to_string()).unwrap_or_else(|e| format!("(invalid: {e})"));
+        println!("{:<18} {:<9} {:<36} {}", p.name, kind, p.file, desc);
+    }
+}
+
+fn generate(args: GenerateArgs) -> Result<()> {
+    if let Some(n) = args.threads {
+        rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global().context("setting up worker threads")?;
+    }
+    let limits = Limits { max_segments: args.max_segments, max_leaves: args.max_leaves, ..Limits::default() };
+    let source = SpeciesSource::resolve(&args.species)?;
+    let t0 = Instant::now();
+    let tree = source.generate(args.seed, &limits, args.iterations)?;
+    let elapsed = t0.elapsed();
+    summary(&tree, elapsed.as_secs_f64());
+    let out = match &args.out {
+        Some(p) if p.as_os_str() == "-" => None,
+        Some(p) => Some(p.clone()),
+        None => {
+            let stem = std::path::Path::new(&args.species).file_stem().map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
+            Some(PathBuf::from("out").join(format!("{stem}.obj")))
+        }
+    };
+    if let Some(path) = out {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        }
+        let (v, f) = write_obj(&tree, &path, ObjOptions { sides: args.sides, leaves: true })
+            .with_context(|| format!("writing {}", path.display()))?;
+        println!("wrote {} ({v} vertices, {f} triangles)", path.display());
+    }
+    Ok(())
+}
+
+fn summary(t: &Tree, seconds: f64) {
+    let s = t.stats();
+    println!("{} (seed {}), generated in {:.1} ms", t.name, t.seed, seconds * 1e3);
+    println!("  {:>5} {:>10} {:>8} {:>9}", "level", "segments", "stems", "leaves");
+    for l in 0..s.segments_per_level.len() {
+        println!("  {:>5} {:>10} {:>8} {:>9}", l, s.segments_per_level[l], s.stems_per_level[l], s.leaves_per_level[l]);
+    }
+    println!(
+        "  {:>5} {:>10} {:>8} {:>9}",
+        "total",
+        t.segments.len(),
+        t.stems.len(),
+        t.leaves.len()
+    );
+    println!("  height {:.2} m, crown width {:.2} m, wood mass {:.1} kg", s.height, s.crown_width, s.mass);
+    println!("  model memory {:.2} MiB, max children per segment {}", s.memory_bytes as f64 / (1 << 20) as f64, t.children.max_children);
+}

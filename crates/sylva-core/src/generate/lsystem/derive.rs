@@ -1,0 +1,230 @@
+//! Parallel derivation of the L-system string.
+//!
+//! Each step rewrites the string in chunks on rayon's pool. A module's production choice
+//! depends only on (seed, step, module index), so chunking and thread count never change
+//! the result. Sizes are counted while rewriting; a step that would pass
+//! [`Limits::max_modules`], [`Limits::max_parameters`] or [`Limits::max_segments`] stops
+//! before allocating past it.
+
+use super::{Grammar, LSystemError, LSystemOptions};
+use crate::limits::LimitExceeded;
+use crate::rng::{child_key, hash_unit, mix64};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+/// One module of the string: a symbol and its parameters `params[off .. off + n]`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Module {
+    /// Symbol (ASCII).
+    pub sym: u8,
+    /// Number of parameters.
+    pub n: u8,
+    /// Offset of the parameters.
+    pub off: u32,
+}
+
+/// A derived string: modules and their flat parameter array.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LString {
+    /// Modules in order.
+    pub modules: Vec<Module>,
+    /// Parameters of all modules.
+    pub params: Vec<f64>,
+}
+
+impl LString {
+    /// Parameters of module `i`.
+    pub fn args(&self, i: usize) -> &[f64] {
+        let m = self.modules[i];
+        &self.params[m.off as usize..m.off as usize + m.n as usize]
+    }
+
+    /// Number of `F` modules (segments the turtle will draw, at most).
+    pub fn count(&self, sym: u8) -> usize {
+        self.modules.iter().filter(|m| m.sym == sym).count()
+    }
+
+    /// The string as text, e.g. `F(1)[+(45)A(0.5)]`.
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        for i in 0..self.modules.len() {
+            s.push(self.modules[i].sym as char);
+            let a = self.args(i);
+            if !a.is_empty() {
+                s.push('(');
+                for (k, v) in a.iter().enumerate() {
+                    if k > 0 {
+                        s.push(',');
+                    }
+                    s.push_str(&format!("{v}"));
+                }
+                s.push(')');
+            }
+        }
+        s
+    }
+}
+
+struct Chunk {
+    modules: Vec<Module>,
+    params: Vec<f64>,
+    segments: usize,
+}
+
+pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSystemError> {
+    let limits = &opts.limits;
+    let iterations = opts.iterations.unwrap_or(g.iterations);
+    let limit_err = |limit: &'static str, value: usize| LSystemError::Limit {
+        file: g.file.clone(),
+        source: LimitExceeded { limit, value },
+    };
+    if iterations > limits.max_iterations {
+        return Err(limit_err("max_iterations", limits.max_iterations as usize));
+    }
+    let mut by_sym: Vec<Vec<usize>> = vec![Vec::new(); 256];
+    for (i, p) in g.productions.iter().enumerate() {
+        by_sym[p.pred as usize].push(i);
+    }
+    // A (symbol, arity) group is stochastic when any of its productions has a probability.
+    let stochastic = |sym: u8, n: usize| by_sym[sym as usize].iter().any(|&i| g.productions[i].arity == n && g.productions[i].prob.is_some());
+
+    let mut cur = LString::default();
+    for (s, args) in &g.axiom {
+        cur.modules.push(Module { sym: *s, n: args.len() as u8, off: cur.params.len() as u32 });
+        cur.params.extend_from_slice(args);
+    }
+    if g.productions.is_empty() {
+        return Ok(cur);
+    }
+    let mut stoch_table = vec![[false; 256]; 256];
+    for (sym, row) in stoch_table.iter_mut().enumerate() {
+        for (n, v) in row.iter_mut().enumerate() {
+            *v = stochastic(sym as u8, n);
+        }
+    }
+    let base_key = mix64(opts.seed ^ 0x4C53_5953_5445_4D00);
+
+    for step in 0..iterations {
+        let step_key = child_key(base_key, step as u64);
+        let n = cur.modules.len();
+        let threads = rayon::current_num_threads().max(1);
+        let chunk = (n / (threads * 4)).clamp(4096, 1 << 20);
+        let total_modules = AtomicUsize::new(0);
+        let total_params = AtomicUsize::new(0);
+        let total_segments = AtomicUsize::new(0);
+        let stop = AtomicBool::new(false);
+        let cur_ref = &cur;
+        let chunks: Vec<Result<Chunk, Option<LSystemError>>> = (0..n.div_ceil(chunk))
+            .into_par_iter()
+            .map(|c| {
+                let lo = c * chunk;
+                let hi = (lo + chunk).min(n);
+                let mut out = Chunk { modules: Vec::new(), params: Vec::new(), segments: 0 };
+                let (mut flushed_m, mut flushed_p, mut flushed_s) = (0usize, 0usize, 0usize);
+                let mut matches: Vec<(usize, f64)> = Vec::new();
+                for j in lo..hi {
+                    let m = cur_ref.modules[j];
+                    let args = cur_ref.args(j);
+                    matches.clear();
+                    let sto = stoch_table[m.sym as usize][m.n as usize];
+                    for &pi in &by_sym[m.sym as usize] {
+                        let p = &g.productions[pi];
+                        if p.arity != m.n as usize {
+                            continue;
+                        }
+                        if let Some(c) = &p.cond {
+                            let v = c.eval(args);
+                            if v == 0.0 || v.is_nan() {
+                                continue;
+                            }
+                        }
+                        matches.push((pi, p.prob.unwrap_or(1.0)));
+                        if !sto {
+                            break;
+                        }
+                    }
+                    let chosen = match matches.len() {
+                        0 => None,
+                        1 => Some(matches[0].0),
+                        _ => {
+                            let total: f64 = matches.iter().map(|m| m.1).sum();
+                            let mut r = hash_unit(child_key(step_key, j as u64)) * total;
+                            let mut pick = matches[matches.len() - 1].0;
+                            for &(pi, w) in &matches {
+                                if r < w {
+                                    pick = pi;
+                                    break;
+                                }
+                                r -= w;
+                            }
+                            Some(pick)
+                        }
+                    };
+                    match chosen {
+                        None => {
+                            out.modules.push(Module { sym: m.sym, n: m.n, off: out.params.len() as u32 });
+                            out.params.extend_from_slice(args);
+                            out.segments += (m.sym == b'F') as usize;
+                        }
+                        Some(pi) => {
+                            for (s, exprs) in &g.productions[pi].succ {
+                                out.modules.push(Module { sym: *s, n: exprs.len() as u8, off: out.params.len() as u32 });
+                                for e in exprs {
+                                    out.params.push(e.eval(args));
+                                }
+                                out.segments += (*s == b'F') as usize;
+                            }
+                        }
+                    }
+                    if out.modules.len() - flushed_m >= 4096 || j + 1 == hi {
+                        let tm = total_modules.fetch_add(out.modules.len() - flushed_m, Ordering::Relaxed) + out.modules.len() - flushed_m;
+                        let tp = total_params.fetch_add(out.params.len() - flushed_p, Ordering::Relaxed) + out.params.len() - flushed_p;
+                        let ts = total_segments.fetch_add(out.segments - flushed_s, Ordering::Relaxed) + out.segments - flushed_s;
+                        flushed_m = out.modules.len();
+                        flushed_p = out.params.len();
+                        flushed_s = out.segments;
+                        if tm > limits.max_modules {
+                            stop.store(true, Ordering::Relaxed);
+                            return Err(Some(limit_err("max_modules", limits.max_modules)));
+                        }
+                        if tp > limits.max_parameters || tp > u32::MAX as usize {
+                            stop.store(true, Ordering::Relaxed);
+                            return Err(Some(limit_err("max_parameters", limits.max_parameters)));
+                        }
+                        if ts > limits.max_segments {
+                            stop.store(true, Ordering::Relaxed);
+                            return Err(Some(limit_err("max_segments", limits.max_segments)));
+                        }
+                        if stop.load(Ordering::Relaxed) {
+                            return Err(None);
+                        }
+                    }
+                }
+                Ok(out)
+            })
+            .collect();
+        // Report the first error in string order (deterministic), preferring a real limit.
+        let mut parts = Vec::with_capacity(chunks.len());
+        let mut stopped = false;
+        for c in chunks {
+            match c {
+                Ok(c) => parts.push(c),
+                Err(Some(e)) => return Err(e),
+                Err(None) => stopped = true,
+            }
+        }
+        if stopped {
+            return Err(limit_err("max_modules", limits.max_modules));
+        }
+        let nm: usize = parts.iter().map(|c| c.modules.len()).sum();
+        let np: usize = parts.iter().map(|c| c.params.len()).sum();
+        let mut next = LString { modules: Vec::with_capacity(nm), params: Vec::with_capacity(np) };
+        for c in parts {
+            let base = next.params.len() as u32;
+            next.modules.extend(c.modules.iter().map(|m| Module { off: m.off + base, ..*m }));
+            next.params.extend_from_slice(&c.params);
+        }
+        cur = next;
+    }
+    Ok(cur)
+}

@@ -1,0 +1,1 @@
+pub use sylva_core;
