@@ -4,6 +4,7 @@
 //! lands that is `sylva generate` on the default species.
 
 use anyhow::{Context, Result};
+
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::time::Instant;

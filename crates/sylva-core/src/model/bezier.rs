@@ -50,6 +50,11 @@ fn deriv_d(p: &[DVec3; 4], t: f64) -> (DVec3, DVec3) {
 /// from a joint to its projection on the curve.
 pub fn fit_cubic_bezier(points: &[Vec3]) -> ([Vec3; 4], f32) {
     assert!(points.len() >= 2, "a stem has at least one segment");
+    if points.len() == 2 {
+        // A straight stem: the control polygon is the segment, split in thirds. Exact.
+        let (a, b) = (points[0], points[1]);
+        return ([a, a + (b - a) / 3.0, a + (b - a) * (2.0 / 3.0), b], 0.0);
+    }
     let pts: Vec<DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
     let n = pts.len();
     let p0 = pts[0];

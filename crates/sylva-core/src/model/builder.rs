@@ -11,8 +11,8 @@ use rayon::prelude::*;
 /// that taper to a point.
 pub const MIN_RADIUS: f64 = 1e-5;
 
-/// One stem as produced by a generator.
-#[derive(Debug, Clone, Default)]
+/// One stem as produced by a generator; its segments live in [`TreeBuilder::segments`].
+#[derive(Debug, Clone, Copy, Default)]
 pub struct StemDraft {
     /// Index of the parent stem in the draft list (must be smaller than this stem's index),
     /// with the parent's local segment index and the fraction along that segment where this
@@ -20,26 +20,34 @@ pub struct StemDraft {
     pub parent: Option<(usize, usize, f64)>,
     /// Branching level.
     pub level: u8,
-    /// Joints: `n + 1` points for `n` segments.
-    pub points: Vec<DVec3>,
-    /// Turtle frame of each segment (`n` entries); local +Y should point along the segment.
-    /// The builder corrects small mismatches with the shortest rotation, keeping the twist.
-    pub frames: Vec<DQuat>,
-    /// Radius at each joint (`n + 1` entries).
-    pub radii: Vec<f64>,
+    /// Number of segments pushed so far.
+    pub segments: u32,
+    /// Draft index of its last segment.
+    pub last: u32,
 }
 
-impl StemDraft {
-    /// Number of segments.
-    pub fn segment_count(&self) -> usize {
-        self.points.len().saturating_sub(1)
-    }
+/// One segment as produced by a generator.
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentDraft {
+    /// Draft stem it belongs to.
+    pub stem: u32,
+    /// Start and end joints.
+    pub start: DVec3,
+    /// End joint.
+    pub end: DVec3,
+    /// Turtle frame; local +Y should point along the segment. The builder corrects small
+    /// mismatches with the shortest rotation, keeping the twist.
+    pub frame: DQuat,
+    /// Radius at the start.
+    pub radius_base: f64,
+    /// Radius at the end.
+    pub radius_tip: f64,
 }
 
 /// One leaf as produced by a generator.
 #[derive(Debug, Clone, Copy)]
 pub struct LeafDraft {
-    /// Draft stem index and local segment index it hangs on.
+    /// Draft stem index it hangs on.
     pub stem: usize,
     /// Local segment index within the stem.
     pub segment: usize,
@@ -53,23 +61,57 @@ pub struct LeafDraft {
     pub length: f64,
 }
 
-/// Collects stems and leaves, then builds a validated [`Tree`].
+/// Collects stems, segments and leaves (flat, in creation order), then builds a validated
+/// [`Tree`].
 #[derive(Debug, Clone, Default)]
 pub struct TreeBuilder {
     /// Stems in creation order (parents before children).
     pub stems: Vec<StemDraft>,
+    /// Segments in creation order (within a stem: base to tip).
+    pub segments: Vec<SegmentDraft>,
     /// Leaves.
     pub leaves: Vec<LeafDraft>,
 }
 
 impl TreeBuilder {
+    /// Adds an empty stem and returns its draft index.
+    pub fn add_stem(&mut self, parent: Option<(usize, usize, f64)>, level: u8) -> usize {
+        self.stems.push(StemDraft { parent, level, segments: 0, last: u32::MAX });
+        self.stems.len() - 1
+    }
+
+    /// Appends a segment to `stem`; returns its local index within the stem.
+    pub fn push_segment(&mut self, stem: usize, start: DVec3, end: DVec3, frame: DQuat, radius_base: f64, radius_tip: f64) -> usize {
+        let index = self.segments.len() as u32;
+        self.segments.push(SegmentDraft { stem: stem as u32, start, end, frame, radius_base, radius_tip });
+        let s = &mut self.stems[stem];
+        s.segments += 1;
+        s.last = index;
+        s.segments as usize - 1
+    }
+
+    /// Appends another builder (a subtree grown separately); its first stem's parent refers to
+    /// a stem of `self` and is kept, every other index is shifted.
+    pub fn append_subtree(&mut self, sub: TreeBuilder) {
+        let so = self.stems.len();
+        let go = self.segments.len() as u32;
+        for (k, mut s) in sub.stems.into_iter().enumerate() {
+            if k > 0 {
+                s.parent = s.parent.map(|(p, seg, f)| (p + so, seg, f));
+            }
+            s.last = s.last.wrapping_add(go);
+            self.stems.push(s);
+        }
+        self.segments.extend(sub.segments.into_iter().map(|g| SegmentDraft { stem: g.stem + so as u32, ..g }));
+        self.leaves.extend(sub.leaves.into_iter().map(|l| LeafDraft { stem: l.stem + so, ..l }));
+    }
+
     /// Scales every height (y) by `factor` — Weber–Penn's ZScale. Orientations are
     /// re-aimed at build time.
     pub fn scale_heights(&mut self, factor: f64) {
-        for s in &mut self.stems {
-            for p in &mut s.points {
-                p.y *= factor;
-            }
+        for g in &mut self.segments {
+            g.start.y *= factor;
+            g.end.y *= factor;
         }
         for l in &mut self.leaves {
             l.position.y *= factor;
@@ -78,27 +120,40 @@ impl TreeBuilder {
 
     /// Total number of segments so far.
     pub fn segment_count(&self) -> usize {
-        self.stems.iter().map(|s| s.segment_count()).sum()
+        self.segments.len()
     }
 
     /// Builds the tree and checks its invariants.
     pub fn build(self, name: &str, seed: u64, wood: WoodProperties) -> Result<Tree, ModelError> {
-        let TreeBuilder { stems: drafts, leaves: leaf_drafts } = self;
-        // Order stems by level, keeping creation order within a level.
-        let mut order: Vec<usize> = (0..drafts.len()).filter(|&i| drafts[i].segment_count() > 0).collect();
-        order.sort_by_key(|&i| drafts[i].level);
-        let mut new_index = vec![u32::MAX; drafts.len()];
-        for (k, &i) in order.iter().enumerate() {
-            new_index[i] = k as u32;
-        }
-        let mut first_seg = vec![0u32; drafts.len()];
-        let mut total = 0usize;
-        for &i in &order {
-            first_seg[i] = total as u32;
-            total += drafts[i].segment_count();
-        }
+        let TreeBuilder { stems: drafts, segments: seg_drafts, leaves: leaf_drafts } = self;
+        let total = seg_drafts.len();
         if total >= NONE as usize {
             return Err(ModelError::TooLarge { what: "segments", count: total });
+        }
+        // Order stems by level, keeping creation order within a level.
+        let mut order: Vec<usize> = (0..drafts.len()).filter(|&i| drafts[i].segments > 0).collect();
+        order.sort_by_key(|&i| drafts[i].level);
+        let mut new_index = vec![u32::MAX; drafts.len()];
+        let mut first_seg = vec![0u32; drafts.len()];
+        let mut acc = 0u32;
+        for (k, &i) in order.iter().enumerate() {
+            new_index[i] = k as u32;
+            first_seg[i] = acc;
+            acc += drafts[i].segments;
+        }
+        if acc as usize != total {
+            return Err(ModelError::Internal(format!("stems count {acc} segments, {total} pushed")));
+        }
+        // Final position of every draft segment (segments of a stem are in creation order).
+        let mut fill = first_seg.clone();
+        let mut src = vec![0u32; total];
+        for (d, g) in seg_drafts.iter().enumerate() {
+            let st = g.stem as usize;
+            if st >= drafts.len() {
+                return Err(ModelError::Internal(format!("segment {d} on missing stem {st}")));
+            }
+            src[fill[st] as usize] = d as u32;
+            fill[st] += 1;
         }
 
         let mut seg = Segments {
@@ -114,47 +169,42 @@ impl TreeBuilder {
             mass: Vec::with_capacity(total),
             stiffness: Vec::with_capacity(total),
         };
-        let mut stems = Stems::default();
-        let mut stem_arc: Vec<Vec<f64>> = Vec::with_capacity(order.len());
+        let nst = order.len();
+        let mut stems = Stems {
+            parent: Vec::with_capacity(nst),
+            level: Vec::with_capacity(nst),
+            first_segment: Vec::with_capacity(nst),
+            segment_count: Vec::with_capacity(nst),
+            attach: Vec::with_capacity(nst),
+            length: Vec::with_capacity(nst),
+            bezier: Vec::new(),
+            bezier_error: Vec::new(),
+        };
+        let mut arc_start = Vec::with_capacity(total);
+        let sanitize = |r: f64| if r.is_finite() { r.max(MIN_RADIUS) } else { MIN_RADIUS };
 
         for (k, &i) in order.iter().enumerate() {
             let d = &drafts[i];
-            let n = d.segment_count();
-            if d.frames.len() != n || d.radii.len() != n + 1 {
-                return Err(ModelError::Internal(format!(
-                    "stem draft {i}: {} points, {} frames, {} radii",
-                    d.points.len(),
-                    d.frames.len(),
-                    d.radii.len()
-                )));
-            }
+            let n = d.segments as usize;
             let (parent_stem, attach_seg) = match d.parent {
                 None => (NONE, None),
                 Some((p, local, frac)) => {
                     let pn = new_index.get(p).copied().unwrap_or(u32::MAX);
-                    if pn == u32::MAX || pn as usize >= k || local >= drafts[p].segment_count() {
+                    if pn == u32::MAX || pn as usize >= k || local >= drafts[p].segments as usize {
                         return Err(ModelError::Internal(format!("stem draft {i}: bad parent {p}/{local}")));
                     }
-                    (pn, Some((first_seg[p] + local as u32, p, local, frac)))
+                    (pn, Some((first_seg[p] + local as u32, frac)))
                 }
             };
             // Radii: positive and non-increasing along the stem.
-            let mut radii = d.radii.clone();
             let mut prev = f64::INFINITY;
-            for r in &mut radii {
-                let v = if r.is_finite() { r.max(MIN_RADIUS) } else { MIN_RADIUS };
-                *r = v.min(prev);
-                prev = *r;
-            }
-            let mut arc = Vec::with_capacity(n + 1);
-            arc.push(0.0);
+            let mut arc = 0.0f64;
+            let f0 = first_seg[i] as usize;
             for s in 0..n {
-                let a = d.points[s];
-                let b = d.points[s + 1];
-                let dir = b - a;
+                let g = &seg_drafts[src[f0 + s] as usize];
+                let dir = g.end - g.start;
                 let len = dir.length();
-                arc.push(arc[s] + len);
-                let frame = d.frames[s].normalize();
+                let frame = g.frame.normalize();
                 let q = if len > 0.0 {
                     let fy = frame * DVec3::Y;
                     (DQuat::from_rotation_arc(fy, dir / len) * frame).normalize()
@@ -163,22 +213,20 @@ impl TreeBuilder {
                 };
                 let q32 = q.as_quat().normalize();
                 let index = seg.parent.len() as u32;
-                let parent = if s == 0 {
-                    attach_seg.map_or(NONE, |(p, ..)| p)
-                } else {
-                    index - 1
-                };
+                let parent = if s == 0 { attach_seg.map_or(NONE, |(p, _)| p) } else { index - 1 };
                 let local = if parent == NONE {
                     q32
                 } else {
                     (seg.orientation[parent as usize].inverse() * q32).normalize()
                 };
-                let (r0, r1) = (radii[s] as f32, radii[s + 1] as f32);
-                let l = len as f32;
+                let r0 = sanitize(g.radius_base).min(prev);
+                let r1 = sanitize(g.radius_tip).min(r0);
+                prev = r1;
+                let (r0, r1, l) = (r0 as f32, r1 as f32, len as f32);
                 seg.parent.push(parent);
                 seg.level.push(d.level);
                 seg.stem.push(k as u32);
-                seg.start.push(a.as_vec3());
+                seg.start.push(g.start.as_vec3());
                 seg.orientation.push(q32);
                 seg.local_orientation.push(local);
                 seg.length.push(l);
@@ -186,16 +234,17 @@ impl TreeBuilder {
                 seg.radius_tip.push(r1);
                 seg.mass.push(wood.segment_mass(l, r0, r1));
                 seg.stiffness.push(wood.segment_stiffness(l, r0));
+                arc_start.push(arc);
+                arc += len;
             }
-            let length = arc[n];
             let attach = match attach_seg {
                 None => 0.0,
-                Some((_, p, local, frac)) => {
-                    let pk = new_index[p] as usize;
-                    let parc = &stem_arc[pk];
-                    let plen = *parc.last().unwrap_or(&0.0);
+                Some((p, frac)) => {
+                    let p = p as usize;
+                    let ps = seg.stem[p] as usize;
+                    let plen = stems.length[ps] as f64;
                     if plen > 0.0 {
-                        ((parc[local] + frac * (parc[local + 1] - parc[local])) / plen).clamp(0.0, 1.0)
+                        ((arc_start[p] + frac * seg.length[p] as f64) / plen).clamp(0.0, 1.0)
                     } else {
                         0.0
                     }
@@ -206,27 +255,30 @@ impl TreeBuilder {
             stems.first_segment.push(first_seg[i]);
             stems.segment_count.push(n as u32);
             stems.attach.push(attach as f32);
-            stems.length.push(length as f32);
-            stem_arc.push(arc);
+            stems.length.push(arc as f32);
         }
 
         // One Bézier per stem, fitted in parallel (each fit depends on its stem alone).
-        let fits: Vec<([Vec3; 4], f32)> = order
-            .par_iter()
-            .map(|&i| {
-                let pts: Vec<Vec3> = drafts[i].points.iter().map(|p| p.as_vec3()).collect();
+        let (bezier, bezier_error): (Vec<[Vec3; 4]>, Vec<f32>) = (0..stems.len())
+            .into_par_iter()
+            .map(|k| {
+                let f = stems.first_segment[k] as usize;
+                let n = stems.segment_count[k] as usize;
+                if n == 1 {
+                    return fit_cubic_bezier(&[seg.start[f], seg.end(f)]);
+                }
+                let mut pts: Vec<Vec3> = seg.start[f..f + n].to_vec();
+                pts.push(seg.end(f + n - 1));
                 fit_cubic_bezier(&pts)
             })
-            .collect();
-        for (b, e) in fits {
-            stems.bezier.push(b);
-            stems.bezier_error.push(e);
-        }
+            .unzip();
+        stems.bezier = bezier;
+        stems.bezier_error = bezier_error;
 
         // Leaves, sorted by segment (stable: creation order within a segment).
         let mut leaf_list: Vec<(u32, &LeafDraft)> = Vec::with_capacity(leaf_drafts.len());
         for l in &leaf_drafts {
-            if l.stem >= drafts.len() || l.segment >= drafts[l.stem].segment_count() {
+            if l.stem >= drafts.len() || l.segment >= drafts[l.stem].segments as usize {
                 return Err(ModelError::Internal(format!("leaf on missing segment {}/{}", l.stem, l.segment)));
             }
             leaf_list.push((first_seg[l.stem] + l.segment as u32, l));

@@ -19,7 +19,7 @@ mod raw;
 mod validate;
 
 pub use bezier::{CubicBezier, fit_cubic_bezier};
-pub use builder::{LeafDraft, StemDraft, TreeBuilder};
+pub use builder::{LeafDraft, SegmentDraft, StemDraft, TreeBuilder};
 pub use raw::{RawLeaf, RawSegment, RawStem};
 pub use validate::ModelError;
 

@@ -104,6 +104,7 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
     }
     let base_key = mix64(opts.seed ^ 0x4C53_5953_5445_4D00);
 
+    let mut growth = (2.0f64, 2.0f64);
     for step in 0..iterations {
         let step_key = child_key(base_key, step as u64);
         let n = cur.modules.len();
@@ -114,12 +115,21 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
         let total_segments = AtomicUsize::new(0);
         let stop = AtomicBool::new(false);
         let cur_ref = &cur;
+        // Growth of the previous step sizes each chunk's output up front.
+        let growth_m = growth.0;
+        let growth_p = growth.1;
         let chunks: Vec<Result<Chunk, Option<LSystemError>>> = (0..n.div_ceil(chunk))
             .into_par_iter()
             .map(|c| {
                 let lo = c * chunk;
                 let hi = (lo + chunk).min(n);
-                let mut out = Chunk { modules: Vec::new(), params: Vec::new(), segments: 0 };
+                let est = ((hi - lo) as f64 * growth_m * 1.05) as usize + 16;
+                let est_p = ((hi - lo) as f64 * growth_p * 1.05) as usize + 16;
+                let mut out = Chunk {
+                    modules: Vec::with_capacity(est.min(limits.max_modules)),
+                    params: Vec::with_capacity(est_p.min(limits.max_parameters)),
+                    segments: 0,
+                };
                 let (mut flushed_m, mut flushed_p, mut flushed_s) = (0usize, 0usize, 0usize);
                 let mut matches: Vec<(usize, f64)> = Vec::new();
                 for j in lo..hi {
@@ -218,6 +228,12 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
         }
         let nm: usize = parts.iter().map(|c| c.modules.len()).sum();
         let np: usize = parts.iter().map(|c| c.params.len()).sum();
+        growth = (nm as f64 / n.max(1) as f64, np as f64 / n.max(1) as f64);
+        if parts.len() == 1 {
+            let c = parts.pop().expect("one part");
+            cur = LString { modules: c.modules, params: c.params };
+            continue;
+        }
         let mut next = LString { modules: Vec::with_capacity(nm), params: Vec::with_capacity(np) };
         for c in parts {
             let base = next.params.len() as u32;

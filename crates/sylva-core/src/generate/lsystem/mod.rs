@@ -182,6 +182,7 @@ impl Grammar {
     pub fn generate(&self, opts: &LSystemOptions) -> Result<Tree, LSystemError> {
         let s = self.derive(opts)?;
         let builder = turtle::interpret(self, &s, &opts.limits)?;
+        drop(s);
         builder
             .build(&self.name, opts.seed, self.wood)
             .map_err(|source| LSystemError::Model { file: self.file.clone(), source })

@@ -7,7 +7,7 @@
 use super::derive::LString;
 use super::{Grammar, LSystemError};
 use crate::limits::{LimitExceeded, Limits};
-use crate::model::{LeafDraft, StemDraft, TreeBuilder};
+use crate::model::{LeafDraft, TreeBuilder};
 use glam::{DMat3, DQuat, DVec3};
 
 #[derive(Debug, Clone, Copy)]
@@ -26,6 +26,9 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
     let deg = std::f64::consts::PI / 180.0;
     let default_angle = g.angle * deg;
     let mut b = TreeBuilder::default();
+    let draws = s.count(b'F').min(limits.max_segments);
+    b.segments.reserve_exact(draws);
+    b.stems.reserve(draws / 2);
     let mut st = State { pos: DVec3::ZERO, q: DQuat::IDENTITY, width: g.width, stem: None, attach: None };
     let mut stack: Vec<State> = Vec::new();
     let mut segments = 0usize;
@@ -68,12 +71,9 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
                 }
                 let stem = match st.stem {
                     Some(k) => {
-                        let d = &mut b.stems[k];
-                        let last = d.radii.len() - 1;
-                        d.radii[last] = radius;
-                        d.points.push(end);
-                        d.frames.push(st.q);
-                        d.radii.push(radius);
+                        // The previous segment's tip takes this segment's base radius.
+                        let last = b.stems[k].last as usize;
+                        b.segments[last].radius_tip = radius;
                         k
                     }
                     None => {
@@ -81,17 +81,11 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
                             Some((ps, pseg)) => (Some((ps, pseg, 1.0)), b.stems[ps].level.saturating_add(1)),
                             None => (None, 0),
                         };
-                        b.stems.push(StemDraft {
-                            parent,
-                            level,
-                            points: vec![st.pos, end],
-                            frames: vec![st.q],
-                            radii: vec![radius, radius],
-                        });
-                        b.stems.len() - 1
+                        b.add_stem(parent, level)
                     }
                 };
-                st.attach = Some((stem, b.stems[stem].segment_count() - 1));
+                let local = b.push_segment(stem, st.pos, end, st.q, radius, radius);
+                st.attach = Some((stem, local));
                 st.stem = Some(stem);
                 st.pos = end;
                 if let Some((t, e)) = g.tropism {

@@ -19,7 +19,7 @@ mod params;
 pub use params::{FieldError, LeafShape, LevelParams, WeberPennParams};
 
 use crate::limits::{LimitExceeded, Limits};
-use crate::model::{LeafDraft, ModelError, StemDraft, Tree, TreeBuilder};
+use crate::model::{LeafDraft, ModelError, Tree, TreeBuilder};
 use crate::rng::{Stream, child_key, mix64};
 use glam::{DQuat, DVec3};
 use rayon::prelude::*;
@@ -276,14 +276,10 @@ impl Gen<'_> {
             if self.segments.fetch_add(nseg, Ordering::Relaxed) + nseg > self.limits.max_segments {
                 return Err(LimitExceeded { limit: "max_segments", value: self.limits.max_segments }.into());
             }
-            let me = b.stems.len();
-            b.stems.push(StemDraft {
-                parent: spec.parent,
-                level: spec.level as u8,
-                points: t.points.clone(),
-                frames: t.frames.clone(),
-                radii: t.radii.clone(),
-            });
+            let me = b.add_stem(spec.parent, spec.level as u8);
+            for s in 0..nseg {
+                b.push_segment(me, t.points[s], t.points[s + 1], t.frames[s], t.radii[s], t.radii[s + 1]);
+            }
             // Clones continue the stem from the split.
             for (j, (local, frames, err)) in t.splits.iter().enumerate() {
                 for (c, f) in frames.iter().enumerate() {
@@ -507,15 +503,7 @@ impl WeberPennParams {
             })
             .collect();
         for sub in subtrees {
-            let sub = sub?;
-            let offset = b.stems.len();
-            for (k, mut s) in sub.stems.into_iter().enumerate() {
-                if k > 0 {
-                    s.parent = s.parent.map(|(ps, seg, f)| (ps + offset, seg, f));
-                }
-                b.stems.push(s);
-            }
-            b.leaves.extend(sub.leaves.into_iter().map(|l| LeafDraft { stem: l.stem + offset, ..l }));
+            b.append_subtree(sub?);
         }
         if (z_scale - 1.0).abs() > 0.0 {
             b.scale_heights(z_scale);

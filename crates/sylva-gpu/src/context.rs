@@ -1,0 +1,128 @@
+//! The GPU context: instance, adapter, device and queue.
+
+use std::sync::OnceLock;
+
+/// Errors setting up or using the GPU.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// No adapter matched.
+    #[error(
+        "no GPU adapter found ({0}). Sylva needs a Vulkan, Metal or DX12 driver; on a machine \
+         without a GPU install Mesa's software rasteriser (Debian/Ubuntu: \
+         `apt-get install mesa-vulkan-drivers libvulkan1`) and set WGPU_BACKEND=vulkan"
+    )]
+    NoAdapter(String),
+    /// The adapter refused the device.
+    #[error("the GPU adapter `{adapter}` refused a device: {message}")]
+    Device { adapter: String, message: String },
+    /// Waiting for the GPU failed.
+    #[error("waiting for the GPU failed: {0}")]
+    Poll(String),
+    /// Mapping a buffer for readback failed.
+    #[error("reading back a GPU buffer failed: {0}")]
+    Map(String),
+    /// An input is larger than the device allows.
+    #[error("{what}: {bytes} bytes exceeds the device's limit of {limit} bytes")]
+    TooLarge { what: &'static str, bytes: u64, limit: u64 },
+}
+
+/// How to choose the adapter.
+#[derive(Debug, Clone, Default)]
+pub struct GpuOptions {
+    /// Prefer a high-performance (discrete) adapter.
+    pub high_performance: bool,
+}
+
+/// What adapter was chosen, for reports and benchmark records.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AdapterSummary {
+    /// Adapter name, e.g. `llvmpipe (LLVM 15.0.6, 256 bits)` or `NVIDIA H100`.
+    pub name: String,
+    /// Backend, e.g. `Vulkan`.
+    pub backend: String,
+    /// Device type, e.g. `Cpu`, `DiscreteGpu`.
+    pub device_type: String,
+    /// Driver name and version.
+    pub driver: String,
+}
+
+impl std::fmt::Display for AdapterSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} ({}, {}, driver {})", self.name, self.backend, self.device_type, self.driver)
+    }
+}
+
+/// A device and its queue, with the adapter it came from.
+#[derive(Debug)]
+pub struct GpuContext {
+    /// The adapter.
+    pub adapter: wgpu::Adapter,
+    /// The device.
+    pub device: wgpu::Device,
+    /// The queue.
+    pub queue: wgpu::Queue,
+    /// Adapter report.
+    pub summary: AdapterSummary,
+    /// Whether kernels can be timed with timestamp queries.
+    pub timestamps: bool,
+}
+
+impl GpuContext {
+    /// Creates a context. The instance reads the environment (`WGPU_BACKEND=vulkan` makes a
+    /// missing Vulkan driver an error instead of a silent fallback to another backend).
+    pub fn new(opts: &GpuOptions) -> Result<Self, GpuError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let power_preference = if opts.high_performance {
+            wgpu::PowerPreference::HighPerformance
+        } else {
+            wgpu::PowerPreference::from_env().unwrap_or_default()
+        };
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let summary = AdapterSummary {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
+        };
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let required_features = if timestamps { wgpu::Features::TIMESTAMP_QUERY } else { wgpu::Features::empty() };
+        // The adapter's own limits: kernels need large storage buffers and, on some
+        // adapters, workgroups above the 256-thread default.
+        let required_limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("sylva"),
+            required_features,
+            required_limits,
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|e| GpuError::Device { adapter: summary.name.clone(), message: e.to_string() })?;
+        Ok(Self { adapter, device, queue, summary, timestamps })
+    }
+
+    /// One context shared by the whole process (tests, benchmarks, the CLI): created on
+    /// first use, reused after.
+    pub fn shared() -> Result<&'static GpuContext, GpuError> {
+        static SHARED: OnceLock<Result<GpuContext, String>> = OnceLock::new();
+        match SHARED.get_or_init(|| GpuContext::new(&GpuOptions::default()).map_err(|e| e.to_string())) {
+            Ok(c) => Ok(c),
+            Err(e) => Err(GpuError::NoAdapter(e.clone())),
+        }
+    }
+
+    /// Blocks until all submitted work has finished.
+    pub fn wait(&self) -> Result<(), GpuError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Poll(e.to_string()))
+    }
+}

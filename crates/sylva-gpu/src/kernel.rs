@@ -1,0 +1,143 @@
+//! A small, uniform way to run a compute kernel: build the pipeline from composed WGSL
+//! ([`crate::shader::compose`]), upload structure-of-arrays buffers, dispatch over any
+//! number of invocations, and read back.
+//!
+//! Kernels index their work item as `gid.x + gid.y * num_workgroups.x * WORKGROUP`, so a
+//! dispatch larger than the 65,535-workgroup limit of one dimension spills into `y`.
+
+use crate::{GpuContext, GpuError};
+use bytemuck::Pod;
+use wgpu::util::DeviceExt;
+
+/// Threads per workgroup used by Sylva's one-dimensional kernels.
+pub const WORKGROUP: u32 = 64;
+
+/// A compiled compute kernel.
+#[derive(Debug)]
+pub struct Kernel {
+    /// Kernel name (for labels and timing).
+    pub name: &'static str,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    max_groups_x: Option<u32>,
+}
+
+impl Kernel {
+    /// Compiles `sources` (composed in order) with entry point `main`.
+    pub fn new(ctx: &GpuContext, name: &'static str, sources: &[&str]) -> Self {
+        let module = ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(name),
+            source: wgpu::ShaderSource::Wgsl(crate::shader::compose(sources).into()),
+        });
+        let pipeline = ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(name),
+            layout: None,
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let layout = pipeline.get_bind_group_layout(0);
+        Self { name, pipeline, layout, max_groups_x: None }
+    }
+
+    /// Caps the workgroups in `x` below the device limit, so tests can exercise the spill
+    /// into `y` without buffers of 4 million elements.
+    pub fn with_max_groups_x(mut self, max: u32) -> Self {
+        self.max_groups_x = Some(max.max(1));
+        self
+    }
+
+    /// Records a dispatch of `invocations` work items with `buffers` bound at 0, 1, 2, …
+    pub fn record(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, buffers: &[&wgpu::Buffer], invocations: u32) {
+        let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+            .collect();
+        let bind = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(self.name), layout: &self.layout, entries: &entries });
+        let groups = invocations.div_ceil(WORKGROUP).max(1);
+        let device_max = ctx.device.limits().max_compute_workgroups_per_dimension.max(1);
+        let max = self.max_groups_x.map_or(device_max, |m| m.min(device_max));
+        let (x, y) = if groups <= max { (groups, 1) } else { (max, groups.div_ceil(max)) };
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+
+    /// Dispatches once and submits.
+    pub fn run(&self, ctx: &GpuContext, buffers: &[&wgpu::Buffer], invocations: u32) {
+        let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(self.name) });
+        self.record(ctx, &mut encoder, buffers, invocations);
+        ctx.queue.submit([encoder.finish()]);
+    }
+}
+
+fn check_size(ctx: &GpuContext, what: &'static str, bytes: u64) -> Result<(), GpuError> {
+    let limit = ctx.device.limits().max_storage_buffer_binding_size as u64;
+    if bytes > limit {
+        return Err(GpuError::TooLarge { what, bytes, limit });
+    }
+    Ok(())
+}
+
+/// Uploads a slice as a storage buffer (at least 16 bytes, as empty bindings are invalid).
+pub fn upload<T: Pod>(ctx: &GpuContext, label: &'static str, data: &[T]) -> Result<wgpu::Buffer, GpuError> {
+    let bytes: &[u8] = bytemuck::cast_slice(data);
+    check_size(ctx, label, bytes.len() as u64)?;
+    let mut padded;
+    let contents = if bytes.len() < 16 {
+        padded = bytes.to_vec();
+        padded.resize(16, 0);
+        &padded[..]
+    } else {
+        bytes
+    };
+    Ok(ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+    }))
+}
+
+/// A storage buffer for `len` elements of `T` to be written by a kernel.
+pub fn output<T: Pod>(ctx: &GpuContext, label: &'static str, len: usize) -> Result<wgpu::Buffer, GpuError> {
+    let bytes = (len * std::mem::size_of::<T>()).max(16) as u64;
+    check_size(ctx, label, bytes)?;
+    Ok(ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    }))
+}
+
+/// Copies `len` elements of `T` from a storage buffer back to the CPU (waits for the GPU).
+pub fn read_back<T: Pod>(ctx: &GpuContext, buffer: &wgpu::Buffer, len: usize) -> Result<Vec<T>, GpuError> {
+    let bytes = (len * std::mem::size_of::<T>()) as u64;
+    if bytes == 0 {
+        return Ok(Vec::new());
+    }
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: bytes,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+    ctx.queue.submit([encoder.finish()]);
+    let slice = staging.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    ctx.wait()?;
+    rx.recv().map_err(|e| GpuError::Map(e.to_string()))?.map_err(|e| GpuError::Map(e.to_string()))?;
+    let view = slice.get_mapped_range().map_err(|e| GpuError::Map(e.to_string()))?;
+    let data = bytemuck::cast_slice::<u8, T>(&view).to_vec();
+    drop(view);
+    staging.unmap();
+    Ok(data)
+}

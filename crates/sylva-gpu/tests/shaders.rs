@@ -1,0 +1,108 @@
+//! WGSL checks that need no GPU: every kernel validates with naga, and every `Pod` struct
+//! matches its WGSL twin in size and member offsets.
+
+use naga::valid::{Capabilities, ValidationFlags, Validator};
+use std::mem::{offset_of, size_of};
+use sylva_core::model::{RawLeaf, RawSegment, RawStem};
+use sylva_gpu::shader::{KERNELS, TREE, compose};
+
+fn parse(src: &str, name: &str) -> naga::Module {
+    naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)))
+}
+
+#[test]
+fn every_kernel_validates_with_naga() {
+    assert!(!KERNELS.is_empty());
+    for (name, parts) in KERNELS {
+        let src = compose(parts);
+        let module = parse(&src, name);
+        Validator::new(ValidationFlags::all(), Capabilities::all())
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+        assert!(module.entry_points.iter().any(|e| e.name == "main"), "{name} has no `main`");
+    }
+}
+
+#[test]
+fn broken_wgsl_is_caught_without_a_gpu() {
+    let src = compose(&[TREE, "fn f() -> f32 { return undefined_thing; }"]);
+    assert!(naga::front::wgsl::parse_str(&src).is_err());
+}
+
+/// (size, [(member, offset)]) of a WGSL struct, from naga's layouter.
+fn wgsl_layout(name: &str) -> (u32, Vec<(String, u32)>) {
+    let module = parse(TREE, "tree.wgsl");
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    for (handle, ty) in module.types.iter() {
+        if ty.name.as_deref() == Some(name) {
+            if let naga::TypeInner::Struct { members, .. } = &ty.inner {
+                let size = layouter[handle].size;
+                return (size, members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect());
+            }
+        }
+    }
+    panic!("no struct {name} in tree.wgsl");
+}
+
+fn check(name: &str, rust_size: usize, rust: &[(&str, usize)]) {
+    let (size, members) = wgsl_layout(name);
+    assert_eq!(size as usize, rust_size, "{name}: WGSL size {size}, Rust {rust_size}");
+    assert_eq!(members.len(), rust.len(), "{name}: member count");
+    for ((wname, woff), (rname, roff)) in members.iter().zip(rust) {
+        assert_eq!(wname, rname, "{name}: member order");
+        assert_eq!(*woff as usize, *roff, "{name}.{wname}: WGSL offset {woff}, Rust {roff}");
+    }
+}
+
+#[test]
+fn pod_structs_match_their_wgsl_twins() {
+    check(
+        "Segment",
+        size_of::<RawSegment>(),
+        &[
+            ("start", offset_of!(RawSegment, start)),
+            ("length", offset_of!(RawSegment, length)),
+            ("orientation", offset_of!(RawSegment, orientation)),
+            ("local_orientation", offset_of!(RawSegment, local_orientation)),
+            ("radius_base", offset_of!(RawSegment, radius_base)),
+            ("radius_tip", offset_of!(RawSegment, radius_tip)),
+            ("mass", offset_of!(RawSegment, mass)),
+            ("stiffness", offset_of!(RawSegment, stiffness)),
+            ("parent", offset_of!(RawSegment, parent)),
+            ("level", offset_of!(RawSegment, level)),
+            ("stem", offset_of!(RawSegment, stem)),
+            ("child_offset", offset_of!(RawSegment, child_offset)),
+            ("child_count", offset_of!(RawSegment, child_count)),
+            ("leaf_offset", offset_of!(RawSegment, leaf_offset)),
+            ("leaf_count", offset_of!(RawSegment, leaf_count)),
+            ("_pad", offset_of!(RawSegment, _pad)),
+        ],
+    );
+    check(
+        "Stem",
+        size_of::<RawStem>(),
+        &[
+            ("bezier", offset_of!(RawStem, bezier)),
+            ("parent", offset_of!(RawStem, parent)),
+            ("level", offset_of!(RawStem, level)),
+            ("first_segment", offset_of!(RawStem, first_segment)),
+            ("segment_count", offset_of!(RawStem, segment_count)),
+            ("attach", offset_of!(RawStem, attach)),
+            ("length", offset_of!(RawStem, length)),
+            ("_pad", offset_of!(RawStem, _pad)),
+        ],
+    );
+    check(
+        "Leaf",
+        size_of::<RawLeaf>(),
+        &[
+            ("position", offset_of!(RawLeaf, position)),
+            ("width", offset_of!(RawLeaf, width)),
+            ("orientation", offset_of!(RawLeaf, orientation)),
+            ("length", offset_of!(RawLeaf, length)),
+            ("segment", offset_of!(RawLeaf, segment)),
+            ("_pad", offset_of!(RawLeaf, _pad)),
+        ],
+    );
+}
