@@ -77,7 +77,8 @@ fn presets() {
             PresetKind::Species => "species",
             PresetKind::Grammar => "grammar",
         };
-        let desc = SpeciesSource::from_preset(p).map(|s| s.name().to_string()).unwrap_or_else(|e| format!("(invalid: {e})"));
+        let desc =
+            SpeciesSource::from_preset(p).map(|s| s.name().to_string()).unwrap_or_else(|e| format!("(invalid: {e})"));
         println!("{:<18} {:<9} {:<36} {}", p.name, kind, p.file, desc);
     }
 }
@@ -96,7 +97,9 @@ fn generate(args: GenerateArgs) -> Result<()> {
         Some(p) if p.as_os_str() == "-" => None,
         Some(p) => Some(p.clone()),
         None => {
-            let stem = std::path::Path::new(&args.species).file_stem().map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
+            let stem = std::path::Path::new(&args.species)
+                .file_stem()
+                .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
             Some(PathBuf::from("out").join(format!("{stem}.obj")))
         }
     };
@@ -118,13 +121,12 @@ fn summary(t: &Tree, seconds: f64) {
     for l in 0..s.segments_per_level.len() {
         println!("  {:>5} {:>10} {:>8} {:>9}", l, s.segments_per_level[l], s.stems_per_level[l], s.leaves_per_level[l]);
     }
-    println!(
-        "  {:>5} {:>10} {:>8} {:>9}",
-        "total",
-        t.segments.len(),
-        t.stems.len(),
-        t.leaves.len()
-    );
+    println!("  {:>5} {:>10} {:>8} {:>9}", "total", t.segments.len(), t.stems.len(), t.leaves.len());
     println!("  height {:.2} m, crown width {:.2} m, wood mass {:.1} kg", s.height, s.crown_width, s.mass);
-    println!("  model memory {:.2} MiB, max children per segment {}", s.memory_bytes as f64 / (1 << 20) as f64, t.children.max_children);
+    println!(
+        "  model memory {:.2} MiB, max children per segment {}",
+        s.memory_bytes as f64 / (1 << 20) as f64,
+        t.children.max_children
+    );
+    println!("  digest {}", t.digest());
 }

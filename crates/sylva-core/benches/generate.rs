@@ -21,7 +21,9 @@ fn benches(c: &mut Criterion) {
     let aspen = SpeciesSource::resolve("quaking_aspen").unwrap();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let mut g = c.benchmark_group("generate_1core");
-    g.bench_function("quaking_aspen", |b| b.iter(|| pool.install(|| black_box(aspen.generate(1, &Default::default(), None).unwrap()))));
+    g.bench_function("quaking_aspen", |b| {
+        b.iter(|| pool.install(|| black_box(aspen.generate(1, &Default::default(), None).unwrap())))
+    });
     g.bench_function("weeping_willow", |b| {
         let w = SpeciesSource::resolve("weeping_willow").unwrap();
         b.iter(|| pool.install(|| black_box(w.generate(1, &Default::default(), None).unwrap())))
@@ -31,8 +33,12 @@ fn benches(c: &mut Criterion) {
     let opts = LSystemOptions { seed: 1, iterations: Some(20), ..Default::default() };
     let t = one_core(|| grammar.generate(&opts).unwrap());
     assert_eq!(t.segments.len(), (1 << 20) - 1);
-    g.bench_function("lsystem_1m_segments", |b| b.iter(|| pool.install(|| black_box(grammar.generate(&opts).unwrap()))));
-    g.bench_function("lsystem_1m_derive_only", |b| b.iter(|| pool.install(|| black_box(grammar.derive(&opts).unwrap()))));
+    g.bench_function("lsystem_1m_segments", |b| {
+        b.iter(|| pool.install(|| black_box(grammar.generate(&opts).unwrap())))
+    });
+    g.bench_function("lsystem_1m_derive_only", |b| {
+        b.iter(|| pool.install(|| black_box(grammar.derive(&opts).unwrap())))
+    });
     g.finish();
 }
 

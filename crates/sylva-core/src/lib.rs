@@ -23,9 +23,7 @@ pub mod rng;
 pub mod species;
 
 pub use generate::lsystem::{Grammar, GrammarError, LSystemOptions};
-pub use generate::weber_penn::{WeberPennParams, WeberPennError};
+pub use generate::weber_penn::{WeberPennError, WeberPennParams};
 pub use limits::{LimitExceeded, Limits};
-pub use model::{
-    Children, Leaves, ModelError, NONE, Segments, Stems, Tree, TreeBuilder, TreeStats, WoodProperties,
-};
+pub use model::{Children, Leaves, ModelError, NONE, Segments, Stems, Tree, TreeBuilder, TreeStats, WoodProperties};
 pub use species::{Preset, PresetKind, SpeciesError, SpeciesSource};

@@ -104,7 +104,11 @@ pub enum SpeciesError {
 pub fn read_text(path: &Path) -> Result<String, String> {
     let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
     if meta.len() > MAX_FILE_BYTES {
-        return Err(format!("file is {} bytes, larger than the {} byte limit for presets and grammars", meta.len(), MAX_FILE_BYTES));
+        return Err(format!(
+            "file is {} bytes, larger than the {} byte limit for presets and grammars",
+            meta.len(),
+            MAX_FILE_BYTES
+        ));
     }
     std::fs::read_to_string(path).map_err(|e| e.to_string())
 }
@@ -200,7 +204,9 @@ impl SpeciesSource {
     /// A shipped preset.
     pub fn from_preset(p: &Preset) -> Result<Self, SpeciesError> {
         match p.kind {
-            PresetKind::Species => Ok(Self::WeberPenn { file: p.file.to_string(), params: Box::new(Self::parse_species(p.text, p.file)?) }),
+            PresetKind::Species => {
+                Ok(Self::WeberPenn { file: p.file.to_string(), params: Box::new(Self::parse_species(p.text, p.file)?) })
+            }
             PresetKind::Grammar => Ok(Self::LSystem(Box::new(Grammar::parse(p.text, p.file)?))),
         }
     }
@@ -225,9 +231,9 @@ impl SpeciesSource {
     /// Grows the tree. `iterations` overrides a grammar's derivation steps.
     pub fn generate(&self, seed: u64, limits: &Limits, iterations: Option<u32>) -> Result<Tree, SpeciesError> {
         match self {
-            Self::WeberPenn { file, params } => params
-                .generate(seed, limits)
-                .map_err(|source| SpeciesError::WeberPenn { file: file.clone(), source }),
+            Self::WeberPenn { file, params } => {
+                params.generate(seed, limits).map_err(|source| SpeciesError::WeberPenn { file: file.clone(), source })
+            }
             Self::LSystem(g) => Ok(g.generate(&LSystemOptions { seed, iterations, limits: *limits })?),
         }
     }

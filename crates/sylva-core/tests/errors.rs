@@ -1,9 +1,9 @@
 //! Bad input gets a clear error naming file, line, column or field — never a panic, a hang
 //! or runaway memory.
 
+use sylva_core::generate::lsystem::LSystemError;
 use sylva_core::species::{SpeciesError, SpeciesSource};
 use sylva_core::{Grammar, GrammarError, LSystemOptions, Limits};
-use sylva_core::generate::lsystem::LSystemError;
 
 fn syntax(text: &str) -> (usize, usize, String, String) {
     match Grammar::parse(text, "bad.lsys") {
@@ -138,7 +138,9 @@ fn runaway_grammar_stops_at_the_segment_limit() {
     }
     // With the default limits (5 million) too, without allocating past them.
     match g.generate(&LSystemOptions { seed: 1, iterations: None, limits: Limits::default() }) {
-        Err(LSystemError::Limit { source, .. }) => assert!(source.limit == "max_segments" || source.limit == "max_modules"),
+        Err(LSystemError::Limit { source, .. }) => {
+            assert!(source.limit == "max_segments" || source.limit == "max_modules")
+        }
         other => panic!("{other:?}"),
     }
     // Growth without F is caught by the module limit.

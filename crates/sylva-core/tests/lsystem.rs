@@ -68,7 +68,11 @@ fn stochastic_choices_follow_probabilities_and_seed() {
     assert_eq!(s1, g.derive(&opts(1)).unwrap());
     assert_ne!(s1, g.derive(&opts(2)).unwrap());
     // Conditions filter before the draw.
-    let g = Grammar::parse("axiom: X(1)X(5)\nX(n) : n > 3 ->(0.5) A\nX(n) : n > 3 ->(0.5) B\nX(n) : n <= 3 -> C\n", "c.lsys").unwrap();
+    let g = Grammar::parse(
+        "axiom: X(1)X(5)\nX(n) : n > 3 ->(0.5) A\nX(n) : n > 3 ->(0.5) B\nX(n) : n <= 3 -> C\n",
+        "c.lsys",
+    )
+    .unwrap();
     for seed in 0..20 {
         let s = g.derive(&LSystemOptions { seed, iterations: Some(1), ..Default::default() }).unwrap().to_text();
         assert!(s == "CA" || s == "CB", "{s}");
@@ -77,9 +81,12 @@ fn stochastic_choices_follow_probabilities_and_seed() {
 
 #[test]
 fn derivation_is_independent_of_thread_count() {
-    let g = Grammar::parse("axiom: A(0)\nA(n) ->(0.7) F(1)[+A(n+1)]A(n+1)\nA(n) ->(0.3) F(0.5)A(n+1)\n", "p.lsys").unwrap();
+    let g =
+        Grammar::parse("axiom: A(0)\nA(n) ->(0.7) F(1)[+A(n+1)]A(n+1)\nA(n) ->(0.3) F(0.5)A(n+1)\n", "p.lsys").unwrap();
     let opts = LSystemOptions { seed: 9, iterations: Some(20), ..Default::default() };
-    let run = |threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| g.derive(&opts).unwrap());
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| g.derive(&opts).unwrap())
+    };
     let one = run(1);
     assert!(one.modules.len() > 50_000);
     assert_eq!(one, run(3));

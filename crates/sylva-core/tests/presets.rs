@@ -81,7 +81,10 @@ fn check(t: &Tree, name: &str) {
 fn every_preset_generates_a_valid_tree() {
     for p in PRESETS {
         for seed in [1, 2] {
-            let t = SpeciesSource::from_preset(p).unwrap().generate(seed, &Default::default(), None).unwrap_or_else(|e| panic!("{}: {e}", p.name));
+            let t = SpeciesSource::from_preset(p)
+                .unwrap()
+                .generate(seed, &Default::default(), None)
+                .unwrap_or_else(|e| panic!("{}: {e}", p.name));
             t.validate().unwrap_or_else(|e| panic!("{}: {e}", p.name));
             check(&t, p.name);
         }

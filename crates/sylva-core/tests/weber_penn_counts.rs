@@ -65,7 +65,8 @@ fn per_level_stem_counts_match_a_hand_calculation() {
         }
     }
     for seed in [1, 99] {
-        let t = SpeciesSource::from_text(SPECIES, "count.toml").unwrap().generate(seed, &Default::default(), None).unwrap();
+        let t =
+            SpeciesSource::from_text(SPECIES, "count.toml").unwrap().generate(seed, &Default::default(), None).unwrap();
         let s = t.stats();
         assert_eq!(s.stems_per_level, vec![1, n1, n2_total, n3_total], "seed {seed}");
         // Segments follow nCurveRes.
@@ -92,7 +93,8 @@ fn trunk_length_and_radius_follow_scale_and_ratio() {
 #[test]
 fn splits_divide_children_instead_of_multiplying_them() {
     let split = SPECIES.replacen("curve_res = 3", "curve_res = 3\nseg_splits = 1\nsplit_angle = 30", 1);
-    let plain = SpeciesSource::from_text(SPECIES, "a.toml").unwrap().generate(1, &Default::default(), None).unwrap().stats();
+    let plain =
+        SpeciesSource::from_text(SPECIES, "a.toml").unwrap().generate(1, &Default::default(), None).unwrap().stats();
     let t = SpeciesSource::from_text(&split, "b.toml").unwrap().generate(1, &Default::default(), None).unwrap();
     let s = t.stats();
     // Each level-1 stem splits once at each of its two inner joints: 1 + 1 + 2 = 4 stems.

@@ -49,18 +49,29 @@ impl Kernel {
     }
 
     /// Records a dispatch of `invocations` work items with `buffers` bound at 0, 1, 2, …
-    pub fn record(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, buffers: &[&wgpu::Buffer], invocations: u32) {
+    pub fn record(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        buffers: &[&wgpu::Buffer],
+        invocations: u32,
+    ) {
         let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
             .iter()
             .enumerate()
             .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
             .collect();
-        let bind = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(self.name), layout: &self.layout, entries: &entries });
+        let bind = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(self.name),
+            layout: &self.layout,
+            entries: &entries,
+        });
         let groups = invocations.div_ceil(WORKGROUP).max(1);
         let device_max = ctx.device.limits().max_compute_workgroups_per_dimension.max(1);
         let max = self.max_groups_x.map_or(device_max, |m| m.min(device_max));
         let (x, y) = if groups <= max { (groups, 1) } else { (max, groups.div_ceil(max)) };
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: None });
+        let mut pass =
+            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(x, y, 1);
@@ -75,7 +86,7 @@ impl Kernel {
 }
 
 fn check_size(ctx: &GpuContext, what: &'static str, bytes: u64) -> Result<(), GpuError> {
-    let limit = ctx.device.limits().max_storage_buffer_binding_size as u64;
+    let limit = ctx.device.limits().max_storage_buffer_binding_size;
     if bytes > limit {
         return Err(GpuError::TooLarge { what, bytes, limit });
     }

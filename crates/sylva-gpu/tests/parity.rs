@@ -40,7 +40,8 @@ fn segment_ends_match_on_random_segments() {
     let n = 300_000;
     let segments: Vec<RawSegment> = (0..n)
         .map(|_| {
-            let axis = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize_or(Vec3::Y);
+            let axis = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0))
+                .normalize_or(Vec3::Y);
             let q = Quat::from_axis_angle(axis, rng.random_range(-3.2..3.2));
             RawSegment {
                 start: [rng.random_range(-50.0..50.0), rng.random_range(0.0..40.0), rng.random_range(-50.0..50.0)],

@@ -45,7 +45,15 @@ fn ring(w: &mut dyn Write, centre: Vec3, q: Quat, r: f32, sides: u32) -> io::Res
 fn obj(t: &Tree, w: &mut dyn Write, opts: ObjOptions) -> io::Result<(usize, usize)> {
     let sides = opts.sides.max(3);
     let s = &t.segments;
-    writeln!(w, "# Sylva tree `{}`, seed {}: {} segments, {} stems, {} leaves", t.name, t.seed, s.len(), t.stems.len(), t.leaves.len())?;
+    writeln!(
+        w,
+        "# Sylva tree `{}`, seed {}: {} segments, {} stems, {} leaves",
+        t.name,
+        t.seed,
+        s.len(),
+        t.stems.len(),
+        t.leaves.len()
+    )?;
     writeln!(w, "o bark")?;
     let mut v = 0usize;
     let mut faces = 0usize;
@@ -76,7 +84,12 @@ fn obj(t: &Tree, w: &mut dyn Write, opts: ObjOptions) -> io::Result<(usize, usiz
         for i in 0..l.len() {
             let q = l.orientation[i];
             let hw = 0.5 * l.width[i];
-            for c in [Vec3::new(-hw, 0.0, 0.0), Vec3::new(hw, 0.0, 0.0), Vec3::new(hw, l.length[i], 0.0), Vec3::new(-hw, l.length[i], 0.0)] {
+            for c in [
+                Vec3::new(-hw, 0.0, 0.0),
+                Vec3::new(hw, 0.0, 0.0),
+                Vec3::new(hw, l.length[i], 0.0),
+                Vec3::new(-hw, l.length[i], 0.0),
+            ] {
                 let p = l.position[i] + q * c;
                 writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
             }

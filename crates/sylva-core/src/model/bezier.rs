@@ -142,10 +142,7 @@ pub fn fit_cubic_bezier(points: &[Vec3]) -> ([Vec3; 4], f32) {
         let d = (eval_d(&ctrl, tk) - *p).length_squared().min(best);
         err = err.max(d.sqrt());
     }
-    (
-        [ctrl[0].as_vec3(), ctrl[1].as_vec3(), ctrl[2].as_vec3(), ctrl[3].as_vec3()],
-        err as f32,
-    )
+    ([ctrl[0].as_vec3(), ctrl[1].as_vec3(), ctrl[2].as_vec3(), ctrl[3].as_vec3()], err as f32)
 }
 
 #[cfg(test)]
@@ -163,12 +160,8 @@ mod tests {
 
     #[test]
     fn reproduces_points_sampled_from_a_cubic() {
-        let truth = CubicBezier([
-            Vec3::ZERO,
-            Vec3::new(0.3, 1.0, 0.0),
-            Vec3::new(1.2, 1.8, 0.4),
-            Vec3::new(2.0, 2.0, 1.0),
-        ]);
+        let truth =
+            CubicBezier([Vec3::ZERO, Vec3::new(0.3, 1.0, 0.0), Vec3::new(1.2, 1.8, 0.4), Vec3::new(2.0, 2.0, 1.0)]);
         // Joints at uneven parameters: the fit must still find the curve.
         let pts: Vec<Vec3> = [0.0, 0.1, 0.25, 0.45, 0.6, 0.8, 0.9, 1.0].iter().map(|&t| truth.eval(t)).collect();
         let (c, err) = fit_cubic_bezier(&pts);

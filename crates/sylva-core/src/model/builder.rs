@@ -81,7 +81,15 @@ impl TreeBuilder {
     }
 
     /// Appends a segment to `stem`; returns its local index within the stem.
-    pub fn push_segment(&mut self, stem: usize, start: DVec3, end: DVec3, frame: DQuat, radius_base: f64, radius_tip: f64) -> usize {
+    pub fn push_segment(
+        &mut self,
+        stem: usize,
+        start: DVec3,
+        end: DVec3,
+        frame: DQuat,
+        radius_base: f64,
+        radius_tip: f64,
+    ) -> usize {
         let index = self.segments.len() as u32;
         self.segments.push(SegmentDraft { stem: stem as u32, start, end, frame, radius_base, radius_tip });
         let s = &mut self.stems[stem];
@@ -214,11 +222,8 @@ impl TreeBuilder {
                 let q32 = q.as_quat().normalize();
                 let index = seg.parent.len() as u32;
                 let parent = if s == 0 { attach_seg.map_or(NONE, |(p, _)| p) } else { index - 1 };
-                let local = if parent == NONE {
-                    q32
-                } else {
-                    (seg.orientation[parent as usize].inverse() * q32).normalize()
-                };
+                let local =
+                    if parent == NONE { q32 } else { (seg.orientation[parent as usize].inverse() * q32).normalize() };
                 let r0 = sanitize(g.radius_base).min(prev);
                 let r1 = sanitize(g.radius_tip).min(r0);
                 prev = r1;
@@ -243,11 +248,7 @@ impl TreeBuilder {
                     let p = p as usize;
                     let ps = seg.stem[p] as usize;
                     let plen = stems.length[ps] as f64;
-                    if plen > 0.0 {
-                        ((arc_start[p] + frac * seg.length[p] as f64) / plen).clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    }
+                    if plen > 0.0 { ((arc_start[p] + frac * seg.length[p] as f64) / plen).clamp(0.0, 1.0) } else { 0.0 }
                 }
             };
             stems.parent.push(parent_stem);
@@ -295,16 +296,7 @@ impl TreeBuilder {
 
         let children = build_children(&seg.parent, &leaves.segment);
         let levels = seg.level.iter().copied().max().map_or(0, |l| l + 1);
-        let tree = Tree {
-            name: name.to_string(),
-            seed,
-            levels,
-            segments: seg,
-            stems,
-            leaves,
-            children,
-            wood,
-        };
+        let tree = Tree { name: name.to_string(), seed, levels, segments: seg, stems, leaves, children, wood };
         tree.validate()?;
         Ok(tree)
     }

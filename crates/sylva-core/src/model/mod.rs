@@ -242,13 +242,7 @@ pub struct TreeStats {
 impl Tree {
     /// Summary statistics.
     pub fn stats(&self) -> TreeStats {
-        let levels = self
-            .segments
-            .level
-            .iter()
-            .map(|&l| l as usize + 1)
-            .max()
-            .unwrap_or(0);
+        let levels = self.segments.level.iter().map(|&l| l as usize + 1).max().unwrap_or(0);
         let mut segments_per_level = vec![0; levels];
         for &l in &self.segments.level {
             segments_per_level[l as usize] += 1;

@@ -94,7 +94,12 @@ impl RawStem {
         let st = &t.stems;
         let b = st.bezier[i];
         Self {
-            bezier: [b[0].extend(1.0).to_array(), b[1].extend(1.0).to_array(), b[2].extend(1.0).to_array(), b[3].extend(1.0).to_array()],
+            bezier: [
+                b[0].extend(1.0).to_array(),
+                b[1].extend(1.0).to_array(),
+                b[2].extend(1.0).to_array(),
+                b[3].extend(1.0).to_array(),
+            ],
             parent: st.parent[i],
             level: st.level[i] as u32,
             first_segment: st.first_segment[i],

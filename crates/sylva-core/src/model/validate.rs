@@ -94,7 +94,13 @@ pub(super) fn validate(t: &Tree) -> Result<(), ModelError> {
             return Err(ModelError::Order { index: i, parent: p });
         }
         if !s.start[i].is_finite() {
-            return Err(ModelError::Value { what: "segment", index: i, field: "start", value: f32::NAN, expected: "finite" });
+            return Err(ModelError::Value {
+                what: "segment",
+                index: i,
+                field: "start",
+                value: f32::NAN,
+                expected: "finite",
+            });
         }
         unit("segment", i, s.orientation[i])?;
         unit("segment", i, s.local_orientation[i])?;
@@ -157,16 +163,24 @@ pub(super) fn validate(t: &Tree) -> Result<(), ModelError> {
     let mut next = 0u32;
     for k in 0..m {
         if st.first_segment[k] != next || st.segment_count[k] == 0 {
-            return Err(ModelError::Structure(format!("stem {k} does not start where stem {} ended", k.wrapping_sub(1))));
+            return Err(ModelError::Structure(format!(
+                "stem {k} does not start where stem {} ended",
+                k.wrapping_sub(1)
+            )));
         }
         let first = st.first_segment[k] as usize;
         let last = first + st.segment_count[k] as usize - 1;
         for i in first..=last {
             if s.stem[i] as usize != k || s.level[i] != st.level[k] {
-                return Err(ModelError::Structure(format!("segment {i} is in stem {k}'s range but says stem {}", s.stem[i])));
+                return Err(ModelError::Structure(format!(
+                    "segment {i} is in stem {k}'s range but says stem {}",
+                    s.stem[i]
+                )));
             }
             if i > first && s.parent[i] as usize != i - 1 {
-                return Err(ModelError::Structure(format!("segment {i}: parent is not the previous segment of its stem")));
+                return Err(ModelError::Structure(format!(
+                    "segment {i}: parent is not the previous segment of its stem"
+                )));
             }
         }
         let parent_stem = st.parent[k];
@@ -175,10 +189,18 @@ pub(super) fn validate(t: &Tree) -> Result<(), ModelError> {
             return Err(ModelError::Structure(format!("stem {k}: parent stem and first segment's parent disagree")));
         }
         if parent_stem != NONE && (parent_stem as usize >= k || s.stem[first_parent as usize] != parent_stem) {
-            return Err(ModelError::Structure(format!("stem {k}: parent stem {parent_stem} does not hold segment {first_parent}")));
+            return Err(ModelError::Structure(format!(
+                "stem {k}: parent stem {parent_stem} does not hold segment {first_parent}"
+            )));
         }
         if !(0.0..=1.0).contains(&st.attach[k]) {
-            return Err(ModelError::Value { what: "stem", index: k, field: "attach", value: st.attach[k], expected: "in [0, 1]" });
+            return Err(ModelError::Value {
+                what: "stem",
+                index: k,
+                field: "attach",
+                value: st.attach[k],
+                expected: "in [0, 1]",
+            });
         }
         let b = st.bezier[k];
         if (b[0] - s.start[first]).length() > tol || (b[3] - s.end(last)).length() > tol {
@@ -220,7 +242,9 @@ pub(super) fn validate(t: &Tree) -> Result<(), ModelError> {
     for k in 0..nl {
         let sg = l.segment[k] as usize;
         if sg >= n || (k > 0 && l.segment[k] < l.segment[k - 1]) {
-            return Err(ModelError::Structure(format!("leaf {k}: segment {sg} missing or leaves not sorted by segment")));
+            return Err(ModelError::Structure(format!(
+                "leaf {k}: segment {sg} missing or leaves not sorted by segment"
+            )));
         }
         unit("leaf", k, l.orientation[k])?;
         positive("leaf", k, "width", l.width[k])?;

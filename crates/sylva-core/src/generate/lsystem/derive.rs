@@ -86,7 +86,9 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
         by_sym[p.pred as usize].push(i);
     }
     // A (symbol, arity) group is stochastic when any of its productions has a probability.
-    let stochastic = |sym: u8, n: usize| by_sym[sym as usize].iter().any(|&i| g.productions[i].arity == n && g.productions[i].prob.is_some());
+    let stochastic = |sym: u8, n: usize| {
+        by_sym[sym as usize].iter().any(|&i| g.productions[i].arity == n && g.productions[i].prob.is_some())
+    };
 
     let mut cur = LString::default();
     for (s, args) in &g.axiom {
@@ -178,7 +180,11 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
                         }
                         Some(pi) => {
                             for (s, exprs) in &g.productions[pi].succ {
-                                out.modules.push(Module { sym: *s, n: exprs.len() as u8, off: out.params.len() as u32 });
+                                out.modules.push(Module {
+                                    sym: *s,
+                                    n: exprs.len() as u8,
+                                    off: out.params.len() as u32,
+                                });
                                 for e in exprs {
                                     out.params.push(e.eval(args));
                                 }
@@ -187,9 +193,14 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
                         }
                     }
                     if out.modules.len() - flushed_m >= 4096 || j + 1 == hi {
-                        let tm = total_modules.fetch_add(out.modules.len() - flushed_m, Ordering::Relaxed) + out.modules.len() - flushed_m;
-                        let tp = total_params.fetch_add(out.params.len() - flushed_p, Ordering::Relaxed) + out.params.len() - flushed_p;
-                        let ts = total_segments.fetch_add(out.segments - flushed_s, Ordering::Relaxed) + out.segments - flushed_s;
+                        let tm = total_modules.fetch_add(out.modules.len() - flushed_m, Ordering::Relaxed)
+                            + out.modules.len()
+                            - flushed_m;
+                        let tp = total_params.fetch_add(out.params.len() - flushed_p, Ordering::Relaxed)
+                            + out.params.len()
+                            - flushed_p;
+                        let ts = total_segments.fetch_add(out.segments - flushed_s, Ordering::Relaxed) + out.segments
+                            - flushed_s;
                         flushed_m = out.modules.len();
                         flushed_p = out.params.len();
                         flushed_s = out.segments;

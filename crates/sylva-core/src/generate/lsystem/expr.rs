@@ -372,7 +372,9 @@ impl<'a, S: Scope> ExprParser<'a, S> {
             Some(c) if c.is_ascii_digit() || c == b'.' => self.number(),
             Some(c) if c.is_ascii_alphabetic() || c == b'_' => {
                 let start = self.pos;
-                while self.pos < self.src.len() && (self.src[self.pos].is_ascii_alphanumeric() || self.src[self.pos] == b'_') {
+                while self.pos < self.src.len()
+                    && (self.src[self.pos].is_ascii_alphanumeric() || self.src[self.pos] == b'_')
+                {
                     self.pos += 1;
                 }
                 let name = std::str::from_utf8(&self.src[start..self.pos]).unwrap_or("");

@@ -71,11 +71,22 @@ impl Ctx<'_> {
     }
 
     fn value_err(&self, field: &str, message: impl Into<String>) -> GrammarError {
-        GrammarError::Value { file: self.file.to_string(), line: self.line, field: field.to_string(), message: message.into() }
+        GrammarError::Value {
+            file: self.file.to_string(),
+            line: self.line,
+            field: field.to_string(),
+            message: message.into(),
+        }
     }
 
     /// Parses a whole line segment as one constant expression.
-    fn constant(&self, text: &str, col0: usize, consts: &HashMap<String, f64>, field: &str) -> Result<f64, GrammarError> {
+    fn constant(
+        &self,
+        text: &str,
+        col0: usize,
+        consts: &HashMap<String, f64>,
+        field: &str,
+    ) -> Result<f64, GrammarError> {
         let scope = Consts(consts);
         let mut p = self.parser(text, col0, &scope);
         let e = p.expr()?;
@@ -90,7 +101,14 @@ impl Ctx<'_> {
     }
 
     /// Parses a list of numbers separated by whitespace.
-    fn numbers(&self, text: &str, col0: usize, consts: &HashMap<String, f64>, field: &str, n: usize) -> Result<Vec<f64>, GrammarError> {
+    fn numbers(
+        &self,
+        text: &str,
+        col0: usize,
+        consts: &HashMap<String, f64>,
+        field: &str,
+        n: usize,
+    ) -> Result<Vec<f64>, GrammarError> {
         let mut out = Vec::new();
         let mut offset = 0;
         for tok in text.split_whitespace() {
@@ -114,8 +132,7 @@ impl Ctx<'_> {
 /// Parses a module string (axiom or successor) with the given scope.
 fn modules<S: Scope>(p: &mut ExprParser<'_, S>) -> Result<Vec<(u8, Vec<Expr>)>, GrammarError> {
     let mut out = Vec::new();
-    loop {
-        let Some(c) = p.peek() else { break };
+    while let Some(c) = p.peek() {
         if !c.is_ascii_graphic() || c == b'(' || c == b')' || c == b',' {
             return Err(p.error("a module symbol (an ASCII character other than `(`, `)` or `,`)"));
         }
@@ -226,7 +243,8 @@ pub(super) fn parse(text: &str, file: &str, limits: &Limits) -> Result<Grammar, 
                 file: file.into(),
                 line: ln + 1,
                 column: indent + 1,
-                expected: "a setting (`axiom:`, `iterations:`, …), `define NAME = value`, or a production `A -> …`".into(),
+                expected: "a setting (`axiom:`, `iterations:`, …), `define NAME = value`, or a production `A -> …`"
+                    .into(),
                 found: format!("`{}`", trimmed.trim_end()),
             });
         };
@@ -332,7 +350,12 @@ pub(super) fn parse(text: &str, file: &str, limits: &Limits) -> Result<Grammar, 
     Ok(g)
 }
 
-fn production(ctx: &Ctx<'_>, line: &str, arrow: usize, consts: &HashMap<String, f64>) -> Result<Production, GrammarError> {
+fn production(
+    ctx: &Ctx<'_>,
+    line: &str,
+    arrow: usize,
+    consts: &HashMap<String, f64>,
+) -> Result<Production, GrammarError> {
     let left = &line[..arrow];
     let (pred_text, cond_text) = match left.find(':') {
         Some(c) => (&left[..c], Some((&left[c + 1..], c + 1))),

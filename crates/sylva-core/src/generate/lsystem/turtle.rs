@@ -38,7 +38,10 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
         symbol: s.modules[i].sym as char,
         message,
     };
-    let limit = |limit: &'static str, value: usize| LSystemError::Limit { file: g.file.clone(), source: LimitExceeded { limit, value } };
+    let limit = |limit: &'static str, value: usize| LSystemError::Limit {
+        file: g.file.clone(),
+        source: LimitExceeded { limit, value },
+    };
     for i in 0..s.modules.len() {
         let m = s.modules[i];
         let a = s.args(i);

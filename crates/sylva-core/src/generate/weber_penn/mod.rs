@@ -149,11 +149,7 @@ impl Gen<'_> {
         } else {
             let z2 = (1.0 - z) * length;
             let depth = if taper < 2.0 || z2 < taper_z { 1.0 } else { taper - 2.0 };
-            let z3 = if taper < 2.0 {
-                z2
-            } else {
-                (z2 - 2.0 * taper_z * (z2 / (2.0 * taper_z) + 0.5).floor()).abs()
-            };
+            let z3 = if taper < 2.0 { z2 } else { (z2 - 2.0 * taper_z * (z2 / (2.0 * taper_z) + 0.5).floor()).abs() };
             if taper < 2.0 && z3 >= taper_z {
                 taper_z
             } else {
@@ -200,7 +196,7 @@ impl Gen<'_> {
                 };
                 if lp.curve_v >= 0.0 {
                     delta += rng.var(lp.curve_v) / n as f64;
-                    frame = frame * rot_x(delta);
+                    frame *= rot_x(delta);
                 } else {
                     let spin = 360.0 * i as f64 / n as f64;
                     frame = frame * rot_y(spin) * rot_x(lp.curve_v.abs() / n as f64) * rot_y(-spin) * rot_x(delta);
@@ -210,7 +206,7 @@ impl Gen<'_> {
                     let declination = h.y.clamp(-1.0, 1.0).acos();
                     let cos_orient = (frame * DVec3::Z).y;
                     let up = self.p.attraction_up * declination * cos_orient / n as f64;
-                    frame = frame * DQuat::from_rotation_x(up.clamp(-declination, std::f64::consts::PI - declination));
+                    frame *= DQuat::from_rotation_x(up.clamp(-declination, std::f64::consts::PI - declination));
                 }
             }
             pos += frame * DVec3::Y * seg_len;
@@ -233,9 +229,8 @@ impl Gen<'_> {
                     let declination = h.y.clamp(-1.0, 1.0).acos().to_degrees();
                     let angle = (lp.split_angle + rng.var(lp.split_angle_v) - declination).max(0.0);
                     let r0 = rng.unit() * 360.0;
-                    let clones = (1..=k)
-                        .map(|j| frame * rot_y(r0 + j as f64 * 360.0 / (k + 1) as f64) * rot_x(angle))
-                        .collect();
+                    let clones =
+                        (1..=k).map(|j| frame * rot_y(r0 + j as f64 * 360.0 / (k + 1) as f64) * rot_x(angle)).collect();
                     density /= (k + 1) as f64;
                     t.splits.push((i + 1 - spec.seg_start, clones, err));
                     frame = frame * rot_y(r0) * rot_x(angle);
@@ -308,7 +303,14 @@ impl Gen<'_> {
     }
 
     /// Child stems (or leaves, on the last level) of one traced stem.
-    fn place_children(&self, spec: &StemSpec, t: &Trace, me: usize, length: f64, b: &mut TreeBuilder) -> Result<Vec<StemSpec>, WeberPennError> {
+    fn place_children(
+        &self,
+        spec: &StemSpec,
+        t: &Trace,
+        me: usize,
+        length: f64,
+        b: &mut TreeBuilder,
+    ) -> Result<Vec<StemSpec>, WeberPennError> {
         let p = self.p;
         let level = spec.level;
         let last = p.levels as usize - 1;
@@ -379,7 +381,14 @@ impl Gen<'_> {
                     let bend = DQuat::IDENTITY.slerp(DQuat::from_rotation_arc(normal, target), p.leaf_bend);
                     q = (bend * q).normalize();
                 }
-                b.leaves.push(LeafDraft { stem: me, segment: local, position: pos, orientation: q, width: leaf_w, length: leaf_len });
+                b.leaves.push(LeafDraft {
+                    stem: me,
+                    segment: local,
+                    position: pos,
+                    orientation: q,
+                    width: leaf_w,
+                    length: leaf_len,
+                });
             }
             return Ok(Vec::new());
         }
@@ -467,14 +476,8 @@ impl WeberPennParams {
         let roll = rng.unit() * 360.0;
         let segments = AtomicUsize::new(0);
         let leaves = AtomicUsize::new(0);
-        let g = Gen {
-            p,
-            limits,
-            segments: &segments,
-            leaves: &leaves,
-            scale_tree,
-            base_length: p.base_size * scale_tree,
-        };
+        let g =
+            Gen { p, limits, segments: &segments, leaves: &leaves, scale_tree, base_length: p.base_size * scale_tree };
         let trunk = StemSpec {
             level: 0,
             start: DVec3::ZERO,

@@ -240,7 +240,10 @@ impl WeberPennParams {
         range!(f("trunk_scale"), self.trunk_scale, 1e-6, 100.0);
         range!(f("trunk_scale_v"), self.trunk_scale_v, 0.0, 100.0);
         if self.trunk_scale_v >= self.trunk_scale {
-            return bad(f("trunk_scale_v"), format!("{} must be smaller than trunk_scale ({})", self.trunk_scale_v, self.trunk_scale));
+            return bad(
+                f("trunk_scale_v"),
+                format!("{} must be smaller than trunk_scale ({})", self.trunk_scale_v, self.trunk_scale),
+            );
         }
         if self.base_splits > 16 {
             return bad(f("base_splits"), format!("{} is outside [0, 16]", self.base_splits));
@@ -263,7 +266,13 @@ impl WeberPennParams {
         if self.level.len() < want || self.level.len() > want + 1 {
             return bad(
                 f("level"),
-                format!("{} [[level]] tables for levels = {}; expected {} (one per stem level) or {} (plus one placing the leaves)", self.level.len(), self.levels, want, want + 1),
+                format!(
+                    "{} [[level]] tables for levels = {}; expected {} (one per stem level) or {} (plus one placing the leaves)",
+                    self.level.len(),
+                    self.levels,
+                    want,
+                    want + 1
+                ),
             );
         }
         for (n, l) in self.level.iter().enumerate() {
@@ -287,7 +296,11 @@ impl WeberPennParams {
             range!(p("rotate_v"), l.rotate_v, 0.0, 360.0);
         }
         let w = &self.wood;
-        for (name, v) in [("wood.young_modulus", w.young_modulus), ("wood.density", w.density), ("wood.leaf_areal_density", w.leaf_areal_density)] {
+        for (name, v) in [
+            ("wood.young_modulus", w.young_modulus),
+            ("wood.density", w.density),
+            ("wood.leaf_areal_density", w.leaf_areal_density),
+        ] {
             if !v.is_finite() || v <= 0.0 {
                 return bad(f(name), format!("{v} must be finite and > 0"));
             }
