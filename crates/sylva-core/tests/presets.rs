@@ -20,7 +20,7 @@ fn dist_to_segment(p: Vec3, a: Vec3, b: Vec3) -> f32 {
 
 fn check(t: &Tree, name: &str) {
     let s = &t.segments;
-    assert!(s.len() > 0, "{name}: no segments");
+    assert!(!s.is_empty(), "{name}: no segments");
     let height = t.height();
     assert!(height > 0.5, "{name}: height {height}");
     let tol = 1e-4 * height;
