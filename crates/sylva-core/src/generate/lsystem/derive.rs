@@ -23,33 +23,58 @@ pub struct Module {
     pub off: u32,
 }
 
-/// A derived string: modules and their flat parameter array.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct LString {
+/// One piece of a derived string: modules and their flat parameter array.
+#[derive(Debug, Clone, Default)]
+pub struct Piece {
     /// Modules in order.
     pub modules: Vec<Module>,
-    /// Parameters of all modules.
+    /// Parameters of this piece's modules.
     pub params: Vec<f64>,
 }
 
+/// A derived string, stored as the pieces the parallel rewrite produced (joining them would
+/// copy the whole string every step). Two strings are equal when their modules and
+/// parameters are, however they are split into pieces.
+#[derive(Debug, Clone, Default)]
+pub struct LString {
+    /// Pieces in order.
+    pub pieces: Vec<Piece>,
+}
+
+impl PartialEq for LString {
+    fn eq(&self, other: &Self) -> bool {
+        self.len() == other.len() && self.iter().zip(other.iter()).all(|(a, b)| a.0 == b.0 && a.1 == b.1)
+    }
+}
+
 impl LString {
-    /// Parameters of module `i`.
-    pub fn args(&self, i: usize) -> &[f64] {
-        let m = self.modules[i];
-        &self.params[m.off as usize..m.off as usize + m.n as usize]
+    /// Number of modules.
+    pub fn len(&self) -> usize {
+        self.pieces.iter().map(|p| p.modules.len()).sum()
     }
 
-    /// Number of `F` modules (segments the turtle will draw, at most).
+    /// True when the string is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Modules in order, as (symbol, parameters).
+    pub fn iter(&self) -> impl Iterator<Item = (u8, &[f64])> + '_ {
+        self.pieces.iter().flat_map(|p| {
+            p.modules.iter().map(move |m| (m.sym, &p.params[m.off as usize..m.off as usize + m.n as usize]))
+        })
+    }
+
+    /// Number of modules with symbol `sym` (`F`: segments the turtle will draw, at most).
     pub fn count(&self, sym: u8) -> usize {
-        self.modules.iter().filter(|m| m.sym == sym).count()
+        self.pieces.iter().map(|p| p.modules.iter().filter(|m| m.sym == sym).count()).sum()
     }
 
     /// The string as text, e.g. `F(1)[+(45)A(0.5)]`.
     pub fn to_text(&self) -> String {
         let mut s = String::new();
-        for i in 0..self.modules.len() {
-            s.push(self.modules[i].sym as char);
-            let a = self.args(i);
+        for (sym, a) in self.iter() {
+            s.push(sym as char);
             if !a.is_empty() {
                 s.push('(');
                 for (k, v) in a.iter().enumerate() {
@@ -90,11 +115,12 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
         by_sym[sym as usize].iter().any(|&i| g.productions[i].arity == n && g.productions[i].prob.is_some())
     };
 
-    let mut cur = LString::default();
+    let mut axiom = Piece::default();
     for (s, args) in &g.axiom {
-        cur.modules.push(Module { sym: *s, n: args.len() as u8, off: cur.params.len() as u32 });
-        cur.params.extend_from_slice(args);
+        axiom.modules.push(Module { sym: *s, n: args.len() as u8, off: axiom.params.len() as u32 });
+        axiom.params.extend_from_slice(args);
     }
+    let mut cur = LString { pieces: vec![axiom] };
     if g.productions.is_empty() {
         return Ok(cur);
     }
@@ -109,9 +135,22 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
     let mut growth = (2.0f64, 2.0f64);
     for step in 0..iterations {
         let step_key = child_key(base_key, step as u64);
-        let n = cur.modules.len();
+        let n = cur.len();
         let threads = rayon::current_num_threads().max(1);
         let chunk = (n / (threads * 4)).clamp(4096, 1 << 20);
+        // Work items: (piece, first module, end module, global index of the first module).
+        let mut work = Vec::new();
+        let mut base = 0usize;
+        for (pi, p) in cur.pieces.iter().enumerate() {
+            let len = p.modules.len();
+            let mut lo = 0;
+            while lo < len {
+                let hi = (lo + chunk).min(len);
+                work.push((pi, lo, hi, base + lo));
+                lo = hi;
+            }
+            base += len;
+        }
         let total_modules = AtomicUsize::new(0);
         let total_params = AtomicUsize::new(0);
         let total_segments = AtomicUsize::new(0);
@@ -120,11 +159,10 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
         // Growth of the previous step sizes each chunk's output up front.
         let growth_m = growth.0;
         let growth_p = growth.1;
-        let chunks: Vec<Result<Chunk, Option<LSystemError>>> = (0..n.div_ceil(chunk))
-            .into_par_iter()
-            .map(|c| {
-                let lo = c * chunk;
-                let hi = (lo + chunk).min(n);
+        let chunks: Vec<Result<Chunk, Option<LSystemError>>> = work
+            .par_iter()
+            .map(|&(pi, lo, hi, global)| {
+                let piece = &cur_ref.pieces[pi];
                 let est = ((hi - lo) as f64 * growth_m * 1.05) as usize + 16;
                 let est_p = ((hi - lo) as f64 * growth_p * 1.05) as usize + 16;
                 let mut out = Chunk {
@@ -135,8 +173,8 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
                 let (mut flushed_m, mut flushed_p, mut flushed_s) = (0usize, 0usize, 0usize);
                 let mut matches: Vec<(usize, f64)> = Vec::new();
                 for j in lo..hi {
-                    let m = cur_ref.modules[j];
-                    let args = cur_ref.args(j);
+                    let m = piece.modules[j];
+                    let args = &piece.params[m.off as usize..m.off as usize + m.n as usize];
                     matches.clear();
                     let sto = stoch_table[m.sym as usize][m.n as usize];
                     for &pi in &by_sym[m.sym as usize] {
@@ -160,7 +198,7 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
                         1 => Some(matches[0].0),
                         _ => {
                             let total: f64 = matches.iter().map(|m| m.1).sum();
-                            let mut r = hash_unit(child_key(step_key, j as u64)) * total;
+                            let mut r = hash_unit(child_key(step_key, (global + j - lo) as u64)) * total;
                             let mut pick = matches[matches.len() - 1].0;
                             for &(pi, w) in &matches {
                                 if r < w {
@@ -240,18 +278,7 @@ pub(super) fn derive(g: &Grammar, opts: &LSystemOptions) -> Result<LString, LSys
         let nm: usize = parts.iter().map(|c| c.modules.len()).sum();
         let np: usize = parts.iter().map(|c| c.params.len()).sum();
         growth = (nm as f64 / n.max(1) as f64, np as f64 / n.max(1) as f64);
-        if parts.len() == 1 {
-            let c = parts.pop().expect("one part");
-            cur = LString { modules: c.modules, params: c.params };
-            continue;
-        }
-        let mut next = LString { modules: Vec::with_capacity(nm), params: Vec::with_capacity(np) };
-        for c in parts {
-            let base = next.params.len() as u32;
-            next.modules.extend(c.modules.iter().map(|m| Module { off: m.off + base, ..*m }));
-            next.params.extend_from_slice(&c.params);
-        }
-        cur = next;
+        cur = LString { pieces: parts.into_iter().map(|c| Piece { modules: c.modules, params: c.params }).collect() };
     }
     Ok(cur)
 }

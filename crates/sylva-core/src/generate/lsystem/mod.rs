@@ -53,7 +53,7 @@ pub(crate) mod expr;
 mod parse;
 mod turtle;
 
-pub use derive::LString;
+pub use derive::{LString, Module, Piece};
 pub use expr::Expr;
 
 use crate::limits::{LimitExceeded, Limits};

@@ -32,30 +32,28 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
     let mut st = State { pos: DVec3::ZERO, q: DQuat::IDENTITY, width: g.width, stem: None, attach: None };
     let mut stack: Vec<State> = Vec::new();
     let mut segments = 0usize;
-    let err = |i: usize, message: String| LSystemError::Turtle {
+    let err = |i: usize, sym: u8, message: String| LSystemError::Turtle {
         file: g.file.clone(),
         module: i,
-        symbol: s.modules[i].sym as char,
+        symbol: sym as char,
         message,
     };
     let limit = |limit: &'static str, value: usize| LSystemError::Limit {
         file: g.file.clone(),
         source: LimitExceeded { limit, value },
     };
-    for i in 0..s.modules.len() {
-        let m = s.modules[i];
-        let a = s.args(i);
+    for (i, (sym, a)) in s.iter().enumerate() {
         let arg = |d: f64| a.first().copied().unwrap_or(d);
         let angle = a.first().map_or(default_angle, |v| v * deg);
-        match m.sym {
+        match sym {
             b'F' | b'f' => {
                 let len = arg(g.step) * g.scale;
                 if !len.is_finite() || len < 0.0 {
-                    return Err(err(i, format!("length {len} must be finite and ≥ 0")));
+                    return Err(err(i, sym, format!("length {len} must be finite and ≥ 0")));
                 }
                 let h = st.q * DVec3::Y;
                 let end = st.pos + h * len;
-                if m.sym == b'f' {
+                if sym == b'f' {
                     st.pos = end;
                     st.stem = None;
                     st.attach = None;
@@ -70,7 +68,7 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
                 }
                 let radius = 0.5 * st.width * g.width_scale;
                 if !radius.is_finite() || radius <= 0.0 {
-                    return Err(err(i, format!("width {} gives a radius that is not > 0", st.width)));
+                    return Err(err(i, sym, format!("width {} gives a radius that is not > 0", st.width)));
                 }
                 let stem = match st.stem {
                     Some(k) => {
@@ -119,7 +117,7 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
             b'!' => {
                 let w = arg(st.width);
                 if !w.is_finite() || w <= 0.0 {
-                    return Err(err(i, format!("width {w} must be finite and > 0")));
+                    return Err(err(i, sym, format!("width {w} must be finite and > 0")));
                 }
                 st.width = w;
             }
@@ -132,16 +130,16 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
             }
             b']' => match stack.pop() {
                 Some(prev) => st = prev,
-                None => return Err(err(i, "`]` without a matching `[`".into())),
+                None => return Err(err(i, sym, "`]` without a matching `[`".into())),
             },
             b'~' => {
                 let length = a.first().map_or(g.leaf.0, |v| v * g.scale);
                 let width = a.get(1).map_or(if a.is_empty() { g.leaf.1 } else { length * 0.5 }, |v| v * g.scale);
                 if !(length.is_finite() && width.is_finite() && length > 0.0 && width > 0.0) {
-                    return Err(err(i, format!("leaf length {length} and width {width} must be finite and > 0")));
+                    return Err(err(i, sym, format!("leaf length {length} and width {width} must be finite and > 0")));
                 }
                 let Some((stem, segment)) = st.attach else {
-                    return Err(err(i, "a leaf needs a segment to hang on: draw an F before it".into()));
+                    return Err(err(i, sym, "a leaf needs a segment to hang on: draw an F before it".into()));
                 };
                 if b.leaves.len() >= limits.max_leaves {
                     return Err(limit("max_leaves", limits.max_leaves));
