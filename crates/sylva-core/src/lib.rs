@@ -21,6 +21,7 @@ pub mod limits;
 pub mod model;
 pub mod rng;
 pub mod species;
+pub mod wind;
 
 pub use generate::lsystem::{Grammar, GrammarError, LSystemOptions};
 pub use generate::weber_penn::{WeberPennError, WeberPennParams};

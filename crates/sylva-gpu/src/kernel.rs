@@ -9,6 +9,22 @@ use crate::{GpuContext, GpuError};
 use bytemuck::Pod;
 use wgpu::util::DeviceExt;
 
+/// How long a kernel took.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KernelTiming {
+    /// GPU time of the compute pass from timestamp queries, where the adapter supports them.
+    pub gpu: Option<std::time::Duration>,
+    /// Wall-clock time from submission to completion.
+    pub wall: std::time::Duration,
+}
+
+impl KernelTiming {
+    /// The best available figure: GPU time if measured, else wall clock.
+    pub fn best(&self) -> std::time::Duration {
+        self.gpu.unwrap_or(self.wall)
+    }
+}
+
 /// Threads per workgroup used by Sylva's one-dimensional kernels.
 pub const WORKGROUP: u32 = 64;
 
@@ -56,6 +72,17 @@ impl Kernel {
         buffers: &[&wgpu::Buffer],
         invocations: u32,
     ) {
+        self.record_inner(ctx, encoder, buffers, invocations, None);
+    }
+
+    fn record_inner(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        buffers: &[&wgpu::Buffer],
+        invocations: u32,
+        timestamps: Option<&wgpu::QuerySet>,
+    ) {
         let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
             .iter()
             .enumerate()
@@ -70,11 +97,51 @@ impl Kernel {
         let device_max = ctx.device.limits().max_compute_workgroups_per_dimension.max(1);
         let max = self.max_groups_x.map_or(device_max, |m| m.min(device_max));
         let (x, y) = if groups <= max { (groups, 1) } else { (max, groups.div_ceil(max)) };
+        let timestamp_writes = timestamps.map(|query_set| wgpu::ComputePassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: Some(0),
+            end_of_pass_write_index: Some(1),
+        });
         let mut pass =
-            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: None });
+            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(x, y, 1);
+    }
+
+    /// Dispatches once, submits and waits, timing the kernel: with timestamp queries when
+    /// the device has them (GPU time of the pass), and always by wall clock from submit to
+    /// completion.
+    pub fn run_timed(&self, ctx: &GpuContext, buffers: &[&wgpu::Buffer], invocations: u32) -> Result<KernelTiming, GpuError> {
+        let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(self.name) });
+        let queries = ctx.timestamps.then(|| {
+            let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("kernel timing"), ty: wgpu::QueryType::Timestamp, count: 2 });
+            let resolve = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps"),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            (set, resolve)
+        });
+        self.record_inner(ctx, &mut encoder, buffers, invocations, queries.as_ref().map(|q| &q.0));
+        if let Some((set, resolve)) = &queries {
+            encoder.resolve_query_set(set, 0..2, resolve, 0);
+        }
+        ctx.wait()?;
+        let start = std::time::Instant::now();
+        ctx.queue.submit([encoder.finish()]);
+        ctx.wait()?;
+        let wall = start.elapsed();
+        let gpu = match &queries {
+            Some((_, resolve)) => {
+                let ts: Vec<u64> = read_back(ctx, resolve, 2)?;
+                let ns = ts[1].saturating_sub(ts[0]) as f64 * ctx.queue.get_timestamp_period() as f64;
+                (ns > 0.0).then(|| std::time::Duration::from_nanos(ns as u64))
+            }
+            None => None,
+        };
+        Ok(KernelTiming { gpu, wall })
     }
 
     /// Dispatches once and submits.

@@ -15,6 +15,8 @@ mod context;
 pub mod kernel;
 pub mod segment_ends;
 pub mod shader;
+pub mod trunk_noise;
+pub mod wind_sample;
 
 pub use context::{AdapterSummary, GpuContext, GpuError, GpuOptions};
 pub use sylva_core;

@@ -5,11 +5,23 @@
 pub const QUAT: &str = include_str!("quat.wgsl");
 /// The tree model's structs (`Segment`, `Stem`, `Leaf`), twins of `sylva_core::model::Raw*`.
 pub const TREE: &str = include_str!("tree.wgsl");
+/// Integer hash and value noise (twin of `sylva_core::cpu::noise`).
+pub const NOISE: &str = include_str!("noise.wgsl");
+/// Wind fields: `Field`, `Wave`, `wind_at(p, t)`; binds the scene at bindings 0 and 1.
+pub const WIND: &str = include_str!("wind.wgsl");
 /// Kernel: segment end points from start, orientation and length.
 pub const SEGMENT_ENDS: &str = include_str!("segment_ends.wgsl");
+/// Kernel: wind velocity at many (x, t) samples.
+pub const WIND_SAMPLE: &str = include_str!("wind_sample.wgsl");
+/// Kernel: trunk noise bands at many (t, tree) samples.
+pub const TRUNK_NOISE: &str = include_str!("trunk_noise.wgsl");
 
 /// Every kernel, as (name, the sources composed in order). Tests validate each with naga.
-pub const KERNELS: &[(&str, &[&str])] = &[("segment_ends", &[QUAT, TREE, SEGMENT_ENDS])];
+pub const KERNELS: &[(&str, &[&str])] = &[
+    ("segment_ends", &[QUAT, TREE, SEGMENT_ENDS]),
+    ("wind_sample", &[NOISE, WIND, WIND_SAMPLE]),
+    ("trunk_noise", &[NOISE, TRUNK_NOISE]),
+];
 
 /// Concatenates WGSL sources into one module.
 pub fn compose(parts: &[&str]) -> String {

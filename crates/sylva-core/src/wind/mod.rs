@@ -1,0 +1,466 @@
+//! Wind fields: velocity `v = G(x, t)` in m/s at a position x (m, +Y up) and time t (s).
+//!
+//! A [`WindScene`] is a sum of fields (Zioma §6.3.1: global wind plus sparse analytic
+//! primitives), read from and written to TOML:
+//!
+//! * [`Constant`]: direction and speed.
+//! * [`SumOfSines`]: Skjermo eqs. 11–14 — waves with amplitude, horizontal direction,
+//!   wavelength (→ w = 2π/λ) and speed (→ φ = speed·w); `sharpness` k selects eq. 14.
+//! * [`GustFront`]: a front travelling across the terrain; wind rises over `width` ahead of
+//!   the front and decays over `length` behind it.
+//! * [`Vortex`]: a Lamb–Oseen vortex about a vertical axis that drifts, fades in and out.
+//! * [`Blast`]: an explosion — an outward shell expanding at `speed` and decaying.
+//! * [`Turbulence`]: spatially coherent noise with a 1/f^β temporal power spectrum
+//!   (Ota 2003), by spectral synthesis: log-spaced waves with amplitudes ∝ f^((1−β)/2),
+//!   advected at `mean_speed` (Taylor's frozen turbulence sets the spatial scale).
+//!
+//! Every field is evaluated through its packed form ([`raw`]) by [`crate::cpu::wind_sample`],
+//! the CPU twin of the WGSL kernel, so the friendly API and the GPU share one definition.
+
+pub mod raw;
+pub mod trunk;
+
+use crate::cpu::wind_sample::wind_at;
+use crate::rng::{Stream, mix64};
+use glam::Vec3;
+use raw::{RawField, RawWave, kind};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Constant wind.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Constant {
+    /// Direction the air moves toward (normalised on use).
+    pub direction: [f32; 3],
+    /// Speed, m/s.
+    pub speed: f32,
+}
+
+/// One wave of a sum of sines (Skjermo eq. 11).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SineWave {
+    /// Amplitude A, m/s.
+    pub amplitude: f32,
+    /// Direction D on the horizontal plane, degrees from +X toward +Z.
+    pub direction_deg: f32,
+    /// Wavelength, m (w = 2π / wavelength).
+    pub wavelength: f32,
+    /// Speed, m/s (φ = speed · w). As printed in eq. 11, the phase `D·x w + t φ` travels
+    /// toward −D.
+    pub speed: f32,
+}
+
+/// Sum of sines (Skjermo eqs. 11–14).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SumOfSines {
+    /// The waves (Skjermo uses at most four; any number works).
+    pub waves: Vec<SineWave>,
+    /// Sharpness exponent k. Absent: eq. 13, `Σ Dᵢ Aᵢ sin θᵢ`. Present: eq. 14,
+    /// `Σ Dᵢ Aᵢ ((sin θᵢ + 1)/2)^k` — the `+1` of Fernando's formulation that the paper
+    /// cites (as printed, a fractional k of a negative sine is undefined). Eq. 14's `1/l`
+    /// (control-polygon length) belongs to the bending method, not the field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sharpness: Option<f32>,
+}
+
+/// A travelling gust front.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GustFront {
+    /// Where the front starts, (x, z) m.
+    pub origin: [f32; 2],
+    /// Travel direction, degrees from +X toward +Z; the wind blows this way.
+    pub direction_deg: f32,
+    /// Peak wind added behind the front, m/s.
+    pub strength: f32,
+    /// Front speed, m/s.
+    pub speed: f32,
+    /// Thickness of the rising edge ahead of the front, m.
+    pub width: f32,
+    /// Decay length of the gust behind the front, m.
+    pub length: f32,
+    /// Half-width of the front across its direction, m.
+    pub radius: f32,
+    /// Time the front leaves `origin`, s.
+    #[serde(default)]
+    pub start: f32,
+}
+
+/// A vortex about a vertical axis (Lamb–Oseen profile: peak tangential speed at `radius`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Vortex {
+    /// Centre at `start`, (x, z) m.
+    pub centre: [f32; 2],
+    /// Drift velocity of the centre, (x, z) m/s.
+    #[serde(default)]
+    pub drift: [f32; 2],
+    /// Peak tangential speed, m/s; positive turns counter-clockwise seen from above.
+    pub strength: f32,
+    /// Core radius, m.
+    pub radius: f32,
+    /// Updraft at the centre, m/s.
+    #[serde(default)]
+    pub updraft: f32,
+    /// Start time, s.
+    #[serde(default)]
+    pub start: f32,
+    /// Lifetime, s.
+    pub duration: f32,
+    /// Fade-in and fade-out time, s.
+    #[serde(default = "one")]
+    pub fade: f32,
+}
+
+/// A blast: an outward shell expanding from `centre` and decaying.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Blast {
+    /// Centre, (x, y, z) m.
+    pub centre: [f32; 3],
+    /// Peak outward wind at the start, m/s.
+    pub strength: f32,
+    /// Time of the explosion, s.
+    #[serde(default)]
+    pub start: f32,
+    /// Expansion speed of the shell, m/s.
+    pub speed: f32,
+    /// Shell thickness, m.
+    pub width: f32,
+    /// Decay time constant, s.
+    pub decay: f32,
+    /// Range beyond which the blast has no effect, m.
+    pub radius: f32,
+}
+
+/// Spatially coherent turbulence with a 1/f^β temporal spectrum.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Turbulence {
+    /// Root-mean-square speed of each horizontal component, m/s.
+    pub intensity: f32,
+    /// Spectral exponent β: power ∝ 1/f^β (5/3 for the inertial range of atmospheric
+    /// turbulence).
+    #[serde(default = "five_thirds")]
+    pub beta: f32,
+    /// Lowest frequency, Hz.
+    #[serde(default = "f_min")]
+    pub f_min: f32,
+    /// Highest frequency, Hz.
+    #[serde(default = "f_max")]
+    pub f_max: f32,
+    /// Number of waves (more: smoother spectrum, slower sampling).
+    #[serde(default = "components")]
+    pub components: u32,
+    /// Speed that carries the eddies, m/s: a wave of frequency f has wavelength
+    /// `mean_speed / f`.
+    #[serde(default = "mean_speed")]
+    pub mean_speed: f32,
+    /// Vertical rms as a fraction of the horizontal.
+    #[serde(default = "vertical")]
+    pub vertical: f32,
+    /// Seed of the random phases and directions.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+fn one() -> f32 {
+    1.0
+}
+fn five_thirds() -> f32 {
+    5.0 / 3.0
+}
+fn f_min() -> f32 {
+    0.01
+}
+fn f_max() -> f32 {
+    5.0
+}
+fn components() -> u32 {
+    64
+}
+fn mean_speed() -> f32 {
+    5.0
+}
+fn vertical() -> f32 {
+    0.3
+}
+
+/// One field of a scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum WindField {
+    /// See [`Constant`].
+    Constant(Constant),
+    /// See [`SumOfSines`].
+    SumOfSines(SumOfSines),
+    /// See [`GustFront`].
+    GustFront(GustFront),
+    /// See [`Vortex`].
+    Vortex(Vortex),
+    /// See [`Blast`].
+    Blast(Blast),
+    /// See [`Turbulence`].
+    Turbulence(Turbulence),
+}
+
+/// A scene's wind: the sum of its fields.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WindScene {
+    /// Fields, summed.
+    #[serde(default, rename = "field")]
+    pub fields: Vec<WindField>,
+}
+
+/// Errors reading or checking a wind scene.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum WindError {
+    /// TOML syntax, unknown keys, wrong types.
+    #[error("{file}:{line}:{column}: {message}")]
+    Toml { file: String, line: usize, column: usize, message: String },
+    /// A value out of range.
+    #[error("{file}: field[{index}].{field}: {message}")]
+    Value { file: String, index: usize, field: &'static str, message: String },
+    /// The file could not be read or written.
+    #[error("{file}: {message}")]
+    Io { file: String, message: String },
+}
+
+/// Largest number of waves in one sum of sines or turbulence field.
+pub const MAX_WAVES: u32 = 4096;
+
+fn horizontal(deg: f32) -> (f32, f32) {
+    let r = deg.to_radians();
+    (r.cos(), r.sin())
+}
+
+impl WindScene {
+    /// Parses TOML; `file` names it in errors.
+    pub fn from_toml(text: &str, file: &str) -> Result<Self, WindError> {
+        let scene: WindScene = toml::from_str(text).map_err(|e| {
+            let offset = e.span().map_or(0, |s| s.start);
+            let before = &text[..offset.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.rfind('\n').map_or(before.len(), |i| before.len() - i - 1) + 1;
+            WindError::Toml { file: file.to_string(), line, column, message: e.message().trim().to_string() }
+        })?;
+        scene.check().map_err(|(index, field, message)| WindError::Value { file: file.to_string(), index, field, message })?;
+        Ok(scene)
+    }
+
+    /// Reads a TOML file.
+    pub fn load(path: &Path) -> Result<Self, WindError> {
+        let file = path.display().to_string();
+        let text = crate::species::read_text(path).map_err(|message| WindError::Io { file: file.clone(), message })?;
+        Self::from_toml(&text, &file)
+    }
+
+    /// TOML text of the scene.
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).expect("wind scenes always serialise")
+    }
+
+    /// Writes the scene as TOML, atomically.
+    pub fn save(&self, path: &Path) -> Result<(), WindError> {
+        let text = self.to_toml();
+        crate::io::write_atomic(path, |w| w.write_all(text.as_bytes()))
+            .map_err(|e| WindError::Io { file: path.display().to_string(), message: e.to_string() })
+    }
+
+    /// Checks ranges: (field index, field name, message) of the first bad value.
+    pub fn check(&self) -> Result<(), (usize, &'static str, String)> {
+        for (i, f) in self.fields.iter().enumerate() {
+            let mut vals: Vec<(&'static str, f32, f32, f32)> = Vec::new(); // name, value, min, max
+            match f {
+                WindField::Constant(c) => {
+                    vals.extend([("speed", c.speed, -1e3, 1e3)]);
+                    for v in c.direction {
+                        vals.push(("direction", v, -1e6, 1e6));
+                    }
+                    if c.direction.iter().all(|v| *v == 0.0) && c.speed != 0.0 {
+                        return Err((i, "direction", "must not be the zero vector".into()));
+                    }
+                }
+                WindField::SumOfSines(s) => {
+                    if s.waves.len() > MAX_WAVES as usize {
+                        return Err((i, "waves", format!("{} waves, at most {MAX_WAVES}", s.waves.len())));
+                    }
+                    if let Some(k) = s.sharpness {
+                        vals.push(("sharpness", k, 1e-3, 100.0));
+                    }
+                    for w in &s.waves {
+                        vals.extend([
+                            ("amplitude", w.amplitude, -1e3, 1e3),
+                            ("direction_deg", w.direction_deg, -1e4, 1e4),
+                            ("wavelength", w.wavelength, 1e-3, 1e7),
+                            ("speed", w.speed, -1e4, 1e4),
+                        ]);
+                    }
+                }
+                WindField::GustFront(g) => vals.extend([
+                    ("origin", g.origin[0], -1e7, 1e7),
+                    ("origin", g.origin[1], -1e7, 1e7),
+                    ("direction_deg", g.direction_deg, -1e4, 1e4),
+                    ("strength", g.strength, -1e3, 1e3),
+                    ("speed", g.speed, 0.0, 1e4),
+                    ("width", g.width, 1e-3, 1e7),
+                    ("length", g.length, 1e-3, 1e7),
+                    ("radius", g.radius, 1e-3, 1e7),
+                    ("start", g.start, -1e7, 1e7),
+                ]),
+                WindField::Vortex(v) => vals.extend([
+                    ("centre", v.centre[0], -1e7, 1e7),
+                    ("centre", v.centre[1], -1e7, 1e7),
+                    ("drift", v.drift[0], -1e4, 1e4),
+                    ("drift", v.drift[1], -1e4, 1e4),
+                    ("strength", v.strength, -1e3, 1e3),
+                    ("radius", v.radius, 1e-3, 1e7),
+                    ("updraft", v.updraft, -1e3, 1e3),
+                    ("start", v.start, -1e7, 1e7),
+                    ("duration", v.duration, 0.0, 1e9),
+                    ("fade", v.fade, 1e-3, 1e9),
+                ]),
+                WindField::Blast(b) => vals.extend([
+                    ("centre", b.centre[0], -1e7, 1e7),
+                    ("centre", b.centre[1], -1e7, 1e7),
+                    ("centre", b.centre[2], -1e7, 1e7),
+                    ("strength", b.strength, -1e4, 1e4),
+                    ("start", b.start, -1e7, 1e7),
+                    ("speed", b.speed, 0.0, 1e5),
+                    ("width", b.width, 1e-3, 1e7),
+                    ("decay", b.decay, 1e-3, 1e9),
+                    ("radius", b.radius, 1e-3, 1e7),
+                ]),
+                WindField::Turbulence(t) => {
+                    if t.components == 0 || t.components > MAX_WAVES {
+                        return Err((i, "components", format!("{} is outside [1, {MAX_WAVES}]", t.components)));
+                    }
+                    vals.extend([
+                        ("intensity", t.intensity, 0.0, 1e3),
+                        ("beta", t.beta, 0.0, 4.0),
+                        ("f_min", t.f_min, 1e-5, 1e3),
+                        ("f_max", t.f_max, 1e-5, 1e3),
+                        ("mean_speed", t.mean_speed, 1e-2, 1e3),
+                        ("vertical", t.vertical, 0.0, 10.0),
+                    ]);
+                    if t.f_max <= t.f_min {
+                        return Err((i, "f_max", format!("{} must be above f_min ({})", t.f_max, t.f_min)));
+                    }
+                }
+            }
+            for (name, v, lo, hi) in vals {
+                if !v.is_finite() {
+                    return Err((i, name, format!("{v} is not a finite number")));
+                }
+                if v < lo || v > hi {
+                    return Err((i, name, format!("{v} is outside [{lo}, {hi}]")));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The packed form the GPU reads (and the CPU evaluates): one record per field and a
+    /// table of waves.
+    pub fn pack(&self) -> (Vec<RawField>, Vec<RawWave>) {
+        let mut fields = Vec::with_capacity(self.fields.len());
+        let mut waves = Vec::new();
+        for f in &self.fields {
+            let mut r = RawField { kind: 0, wave_offset: waves.len() as u32, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] };
+            match f {
+                WindField::Constant(c) => {
+                    r.kind = kind::CONSTANT;
+                    let d = Vec3::from_array(c.direction).normalize_or_zero() * c.speed;
+                    r.a = [d.x, d.y, d.z, 0.0];
+                }
+                WindField::SumOfSines(s) => {
+                    r.kind = kind::SUM_OF_SINES;
+                    r.a = [s.sharpness.unwrap_or(1.0), if s.sharpness.is_some() { 1.0 } else { 0.0 }, 0.0, 0.0];
+                    for w in &s.waves {
+                        let (dx, dz) = horizontal(w.direction_deg);
+                        let wn = std::f32::consts::TAU / w.wavelength;
+                        waves.push(RawWave {
+                            dir: [dx * w.amplitude, 0.0, dz * w.amplitude, 0.0],
+                            k: [dx * wn, 0.0, dz * wn, w.speed * wn],
+                            phase: [0.0; 4],
+                        });
+                    }
+                }
+                WindField::GustFront(g) => {
+                    r.kind = kind::GUST_FRONT;
+                    let (dx, dz) = horizontal(g.direction_deg);
+                    r.a = [g.origin[0], g.origin[1], dx, dz];
+                    r.b = [g.strength, g.speed, g.width, g.length];
+                    r.c = [g.start, g.radius, 0.0, 0.0];
+                }
+                WindField::Vortex(v) => {
+                    r.kind = kind::VORTEX;
+                    r.a = [v.centre[0], v.centre[1], v.drift[0], v.drift[1]];
+                    r.b = [v.strength, v.radius, v.start, v.duration];
+                    r.c = [v.fade, v.updraft, 0.0, 0.0];
+                }
+                WindField::Blast(b) => {
+                    r.kind = kind::BLAST;
+                    r.a = [b.centre[0], b.centre[1], b.centre[2], b.strength];
+                    r.b = [b.start, b.speed, b.width, b.decay];
+                    r.c = [b.radius, 0.0, 0.0, 0.0];
+                }
+                WindField::Turbulence(t) => {
+                    r.kind = kind::TURBULENCE;
+                    waves.extend(t.waves());
+                }
+            }
+            r.wave_count = waves.len() as u32 - r.wave_offset;
+            fields.push(r);
+        }
+        (fields, waves)
+    }
+
+    /// Wind velocity at `p` and `t` (packs the scene each call; pack once and use
+    /// [`crate::cpu::wind_sample::wind_at`] in loops).
+    pub fn sample(&self, p: Vec3, t: f32) -> Vec3 {
+        let (f, w) = self.pack();
+        wind_at(&f, &w, p, t)
+    }
+}
+
+impl Turbulence {
+    /// The waves of the spectral synthesis: frequencies log-spaced (jittered) over
+    /// [f_min, f_max]; amplitude² ∝ f^(1−β) (waves per unit frequency thin out as 1/f, so
+    /// the power spectral density goes as f^(−β)); normalised so each horizontal component
+    /// has rms `intensity`; random phase; velocity direction random, mostly horizontal;
+    /// wave vector horizontal, random direction, |k| = 2π f / mean_speed.
+    pub fn waves(&self) -> Vec<RawWave> {
+        let n = self.components as usize;
+        let mut rng = Stream::new(mix64(self.seed ^ 0x7475_7262));
+        let ratio = (self.f_max / self.f_min) as f64;
+        let mut out = Vec::with_capacity(n);
+        let mut power = 0.0f64;
+        for i in 0..n {
+            let u = (i as f64 + rng.unit()) / n as f64;
+            let f = self.f_min as f64 * ratio.powf(u);
+            let a = f.powf((1.0 - self.beta as f64) / 2.0);
+            let heading = rng.unit() * std::f64::consts::TAU;
+            let tilt = (rng.unit() * 2.0 - 1.0) * self.vertical as f64;
+            let dir = glam::DVec3::new(heading.cos(), tilt, heading.sin());
+            let kdir = rng.unit() * std::f64::consts::TAU;
+            let kmag = std::f64::consts::TAU * f / self.mean_speed as f64;
+            let phase = rng.unit();
+            // Mean square of one horizontal component: a² · ½ · ½ (sin² and cos² of heading).
+            power += a * a * 0.25;
+            out.push((dir * a, [kdir.cos() * kmag, 0.0, kdir.sin() * kmag], f, phase));
+        }
+        let scale = if power > 0.0 { self.intensity as f64 / power.sqrt() } else { 0.0 };
+        out.into_iter()
+            .map(|(d, k, f, phase)| RawWave {
+                dir: [(d.x * scale) as f32, (d.y * scale) as f32, (d.z * scale) as f32, 0.0],
+                k: [k[0] as f32, 0.0, k[2] as f32, f as f32],
+                phase: [phase as f32, 0.0, 0.0, 0.0],
+            })
+            .collect()
+    }
+}

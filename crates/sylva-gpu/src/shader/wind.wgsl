@@ -1,0 +1,138 @@
+// Wind fields, shared by every kernel that samples the wind. Twin:
+// sylva_core::cpu::wind_sample::{field_at, wind_at} (same operations, same order).
+// A kernel that composes this file binds the scene at group 0, bindings 0 and 1.
+
+const TAU: f32 = 6.283185307179586;
+const KIND_CONSTANT: u32 = 0u;
+const KIND_SUM_OF_SINES: u32 = 1u;
+const KIND_GUST_FRONT: u32 = 2u;
+const KIND_VORTEX: u32 = 3u;
+const KIND_BLAST: u32 = 4u;
+const KIND_TURBULENCE: u32 = 5u;
+
+struct Field {
+    kind: u32,
+    wave_offset: u32,
+    wave_count: u32,
+    _pad: u32,
+    a: vec4<f32>,
+    b: vec4<f32>,
+    c: vec4<f32>,
+}
+
+struct Wave {
+    dir: vec4<f32>,
+    k: vec4<f32>,
+    phase: vec4<f32>,
+}
+
+@group(0) @binding(0) var<storage, read> wind_fields: array<Field>;
+@group(0) @binding(1) var<storage, read> wind_waves: array<Wave>;
+
+fn smooth_step(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = clamp((x - e0) / (e1 - e0), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
+fn field_at(f: Field, p: vec3<f32>, t: f32) -> vec3<f32> {
+    switch f.kind {
+        case KIND_CONSTANT: {
+            return f.a.xyz;
+        }
+        case KIND_SUM_OF_SINES: {
+            let sharp = f.a.x;
+            let mode = f.a.y;
+            var v = vec3<f32>(0.0);
+            for (var i = f.wave_offset; i < f.wave_offset + f.wave_count; i++) {
+                let w = wind_waves[i];
+                let th = dot(w.k.xyz, p) + w.k.w * t;
+                let s = sin(th);
+                var h = s;
+                if (mode >= 0.5) {
+                    h = pow((s + 1.0) * 0.5, sharp);
+                }
+                v += w.dir.xyz * h;
+            }
+            return v;
+        }
+        case KIND_GUST_FRONT: {
+            let rel = vec2<f32>(p.x - f.a.x, p.z - f.a.y);
+            let d = f.a.zw;
+            let along = dot(rel, d);
+            let s = along - f.b.y * (t - f.c.x);
+            var g: f32;
+            if (s >= 0.0) {
+                g = 1.0 - smooth_step(0.0, f.b.z, s);
+            } else {
+                g = exp(s / f.b.w);
+            }
+            let lateral = abs(rel.x * -d.y + rel.y * d.x);
+            let lat = 1.0 - smooth_step(0.5 * f.c.y, f.c.y, lateral);
+            let behind_origin = smooth_step(-f.b.z, 0.0, along);
+            let a = f.b.x * g * lat * behind_origin;
+            return vec3<f32>(d.x * a, 0.0, d.y * a);
+        }
+        case KIND_VORTEX: {
+            let tau = t - f.b.z;
+            if (tau < 0.0 || tau > f.b.w) {
+                return vec3<f32>(0.0);
+            }
+            let env = smooth_step(0.0, f.c.x, tau) * smooth_step(0.0, f.c.x, f.b.w - tau);
+            let cx = f.a.x + f.a.z * tau;
+            let cz = f.a.y + f.a.w * tau;
+            let rx = p.x - cx;
+            let rz = p.z - cz;
+            let d2 = rx * rx + rz * rz;
+            let r2 = f.b.y * f.b.y;
+            let up = f.c.y * exp(-d2 / r2);
+            let d = sqrt(d2);
+            if (d < 1e-6) {
+                return vec3<f32>(0.0, env * up, 0.0);
+            }
+            // 1 - e^(-x), by its series near the axis where the subtraction cancels.
+            let x = 1.256 * d2 / r2;
+            var one_minus = 1.0 - exp(-x);
+            if (x < 1e-2) {
+                one_minus = x * (1.0 - 0.5 * x);
+            }
+            let vt = f.b.x * 1.398 * (f.b.y / d) * one_minus;
+            return vec3<f32>(env * vt * rz / d, env * up, env * vt * -rx / d);
+        }
+        case KIND_BLAST: {
+            let tau = t - f.b.x;
+            let rel = p - f.a.xyz;
+            let d = length(rel);
+            if (tau < 0.0 || d < 1e-6) {
+                return vec3<f32>(0.0);
+            }
+            let x = (d - f.b.y * tau) / f.b.z;
+            let shell = exp(-(x * x));
+            let amp = f.a.w * exp(-tau / f.b.w) * shell * (1.0 - smooth_step(0.8 * f.c.x, f.c.x, d));
+            return rel * (amp / d);
+        }
+        case KIND_TURBULENCE: {
+            var v = vec3<f32>(0.0);
+            for (var i = f.wave_offset; i < f.wave_offset + f.wave_count; i++) {
+                let w = wind_waves[i];
+                let c0 = w.k.w * t + w.phase.x;
+                let cyc = c0 - floor(c0);
+                let th = TAU * cyc - dot(w.k.xyz, p);
+                v += w.dir.xyz * sin(th);
+            }
+            return v;
+        }
+        default: {
+            return vec3<f32>(0.0);
+        }
+    }
+}
+
+// The scene's wind at p and t: the sum of its fields.
+fn wind_at(p: vec3<f32>, t: f32) -> vec3<f32> {
+    var v = vec3<f32>(0.0);
+    let n = arrayLength(&wind_fields);
+    for (var i = 0u; i < n; i++) {
+        v += field_at(wind_fields[i], p, t);
+    }
+    return v;
+}

@@ -1,0 +1,45 @@
+//! GPU twin of [`sylva_core::cpu::wind_sample`]: the wind of a scene at many (x, t).
+
+use crate::kernel::{Kernel, KernelTiming, output, read_back, upload};
+use crate::shader::{NOISE, WIND, WIND_SAMPLE};
+use crate::{GpuContext, GpuError};
+use sylva_core::wind::WindScene;
+use sylva_core::wind::raw::{RawField, RawWave};
+
+/// A scene uploaded once, sampled many times.
+#[derive(Debug)]
+pub struct WindSampler {
+    kernel: Kernel,
+    fields: wgpu::Buffer,
+    waves: wgpu::Buffer,
+}
+
+impl WindSampler {
+    /// Compiles the kernel and uploads the packed scene.
+    pub fn new(ctx: &GpuContext, scene: &WindScene) -> Result<Self, GpuError> {
+        let (fields, waves) = scene.pack();
+        Self::from_raw(ctx, &fields, &waves)
+    }
+
+    /// From packed fields and waves. An empty scene is bound as one zero constant field.
+    pub fn from_raw(ctx: &GpuContext, fields: &[RawField], waves: &[RawWave]) -> Result<Self, GpuError> {
+        let zero_field = [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
+        let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
+        let fields = upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { fields })?;
+        let waves = upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { waves })?;
+        Ok(Self { kernel: Kernel::new(ctx, "wind_sample", &[NOISE, WIND, WIND_SAMPLE]), fields, waves })
+    }
+
+    /// Velocities (x, y, z, 0) at samples (x, y, z, t).
+    pub fn sample(&self, ctx: &GpuContext, samples: &[[f32; 4]]) -> Result<Vec<[f32; 4]>, GpuError> {
+        Ok(self.sample_timed(ctx, samples)?.0)
+    }
+
+    /// [`Self::sample`], with the kernel's timing (upload and readback excluded).
+    pub fn sample_timed(&self, ctx: &GpuContext, samples: &[[f32; 4]]) -> Result<(Vec<[f32; 4]>, KernelTiming), GpuError> {
+        let input = upload(ctx, "wind samples", samples)?;
+        let out = output::<[f32; 4]>(ctx, "wind velocities", samples.len())?;
+        let timing = self.kernel.run_timed(ctx, &[&self.fields, &self.waves, &input, &out], samples.len() as u32)?;
+        Ok((read_back(ctx, &out, samples.len())?, timing))
+    }
+}

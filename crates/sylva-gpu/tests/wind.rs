@@ -1,0 +1,170 @@
+//! Wind fields and trunk noise: GPU vs CPU on a million random (x, t) samples per field.
+
+mod common;
+
+use glam::Vec3;
+use rand::{Rng, SeedableRng};
+use sylva_core::wind::trunk::TrunkNoise;
+use sylva_core::wind::*;
+
+const SAMPLES: usize = 1_000_000;
+
+/// Random samples: x, z in ±150 m, y in 0–40 m, t in 0–120 s.
+fn samples(seed: u64) -> Vec<[f32; 4]> {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    (0..SAMPLES)
+        .map(|_| {
+            [rng.random_range(-150.0..150.0), rng.random_range(0.0..40.0), rng.random_range(-150.0..150.0), rng.random_range(0.0..120.0)]
+        })
+        .collect()
+}
+
+/// One scene per field kind, with randomised parameters, and each field's tolerance: the
+/// largest allowed |v_gpu − v_cpu| as a fraction of the field's peak speed.
+///
+/// 1e-5 for every field: a handful of f32 operations whose rounding may differ (exp and sin
+/// are not correctly rounded on either side). Measured on lavapipe: ≤ 5e-7. The phases of
+/// the sums of sines and of turbulence reach ~1,500 rad, whose last bit is ~1e-4 rad: a GPU
+/// that contracts `a * b + c` into a fused multiply-add where the CPU does not could exceed
+/// this bound there; lavapipe does not.
+fn scenes(rng: &mut rand::rngs::StdRng) -> Vec<(&'static str, WindScene, f32, f32)> {
+    let mut r = |a: f32, b: f32| rng.random_range(a..b);
+    let constant = Constant { direction: [r(-1.0, 1.0), r(-0.2, 0.2), r(-1.0, 1.0)], speed: r(1.0, 20.0) };
+    let peak_c = constant.speed;
+    let waves: Vec<SineWave> = (0..4)
+        .map(|_| SineWave { amplitude: r(0.5, 4.0), direction_deg: r(0.0, 360.0), wavelength: r(5.0, 80.0), speed: r(1.0, 10.0) })
+        .collect();
+    let peak_s: f32 = waves.iter().map(|w| w.amplitude).sum();
+    let sines = SumOfSines { waves: waves.clone(), sharpness: None };
+    let sharp = SumOfSines { waves, sharpness: Some(r(1.5, 6.0)) };
+    let gust = GustFront {
+        origin: [r(-100.0, 0.0), r(-50.0, 50.0)],
+        direction_deg: r(0.0, 360.0),
+        strength: r(5.0, 20.0),
+        speed: r(3.0, 15.0),
+        width: r(5.0, 30.0),
+        length: r(10.0, 100.0),
+        radius: r(50.0, 200.0),
+        start: r(0.0, 30.0),
+    };
+    let peak_g = gust.strength;
+    let vortex = Vortex {
+        centre: [r(-50.0, 50.0), r(-50.0, 50.0)],
+        drift: [r(-2.0, 2.0), r(-2.0, 2.0)],
+        strength: r(5.0, 30.0),
+        radius: r(5.0, 40.0),
+        updraft: r(0.0, 5.0),
+        start: r(0.0, 20.0),
+        duration: r(30.0, 90.0),
+        fade: r(1.0, 10.0),
+    };
+    let peak_v = vortex.strength + vortex.updraft;
+    let blast = Blast {
+        centre: [r(-50.0, 50.0), r(0.0, 5.0), r(-50.0, 50.0)],
+        strength: r(10.0, 60.0),
+        start: r(0.0, 30.0),
+        speed: r(20.0, 340.0),
+        width: r(2.0, 20.0),
+        decay: r(1.0, 20.0),
+        radius: r(50.0, 250.0),
+    };
+    let peak_b = blast.strength;
+    let turb = Turbulence {
+        intensity: r(0.5, 4.0),
+        beta: r(1.0, 2.0),
+        f_min: 0.01,
+        f_max: 5.0,
+        components: 64,
+        mean_speed: r(2.0, 12.0),
+        vertical: 0.3,
+        seed: 7,
+    };
+    let peak_t: f32 = turb.waves().iter().map(|w| Vec3::from_slice(&w.dir[..3]).length()).sum();
+    let one = |f: WindField| WindScene { fields: vec![f] };
+    vec![
+        ("constant", one(WindField::Constant(constant)), peak_c, 1e-5),
+        ("sum of sines (eq. 13)", one(WindField::SumOfSines(sines)), peak_s, 1e-5),
+        ("sum of sines (eq. 14)", one(WindField::SumOfSines(sharp)), peak_s, 1e-5),
+        ("gust front", one(WindField::GustFront(gust)), peak_g, 1e-5),
+        ("vortex", one(WindField::Vortex(vortex)), peak_v, 1e-5),
+        ("blast", one(WindField::Blast(blast)), peak_b, 1e-5),
+        ("turbulence", one(WindField::Turbulence(turb)), peak_t, 1e-5),
+    ]
+}
+
+#[test]
+fn every_field_matches_on_a_million_random_samples() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(2024);
+    let s = samples(1);
+    for (name, scene, peak, tol) in scenes(&mut rng) {
+        let gpu = sylva_gpu::wind_sample::WindSampler::new(ctx, &scene).unwrap().sample(ctx, &s).unwrap();
+        let (fields, waves) = scene.pack();
+        let mut cpu = vec![[0.0f32; 4]; s.len()];
+        sylva_core::cpu::wind_sample(&fields, &waves, &s, &mut cpu);
+        let mut worst = 0.0f32;
+        let mut nonzero = 0usize;
+        for i in 0..s.len() {
+            let d = (Vec3::from_slice(&gpu[i][..3]) - Vec3::from_slice(&cpu[i][..3])).length() / peak;
+            worst = worst.max(d);
+            nonzero += (Vec3::from_slice(&cpu[i][..3]).length() > 1e-3 * peak) as usize;
+        }
+        println!("{name:<22} worst |Δv| / peak = {worst:.2e} (tolerance {tol:.0e}), {nonzero} non-zero samples");
+        assert!(worst <= tol, "{name}: {worst:e} > {tol:e}");
+        assert!(nonzero > 1000, "{name}: the random samples barely touch the field ({nonzero})");
+    }
+}
+
+#[test]
+fn a_composed_scene_matches_too() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(99);
+    let mut scene = WindScene::default();
+    let mut peak = 0.0;
+    for (_, s, p, _) in scenes(&mut rng) {
+        scene.fields.extend(s.fields);
+        peak += p;
+    }
+    let s = samples(2);
+    let gpu = sylva_gpu::wind_sample::WindSampler::new(ctx, &scene).unwrap().sample(ctx, &s[..200_000]).unwrap();
+    for (i, x) in s[..200_000].iter().enumerate().step_by(7) {
+        let cpu = scene.sample(Vec3::new(x[0], x[1], x[2]), x[3]);
+        assert!((Vec3::from_slice(&gpu[i][..3]) - cpu).length() <= 1e-5 * peak, "sample {i}");
+    }
+}
+
+/// Trunk angles agree within 1e-6 rad: value noise is integer hashing (bit-identical on both
+/// sides) plus a few f32 operations.
+#[test]
+fn trunk_noise_matches_on_a_million_samples() {
+    let Some(ctx) = common::gpu() else { return };
+    let noise = TrunkNoise::new(0.12, 13.0, 50.0, 8.0, 8e9, 800.0, 15.0);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+    let s: Vec<[f32; 4]> =
+        (0..SAMPLES).map(|_| [rng.random_range(0.0..600.0), f32::from_bits(rng.random::<u32>() & 0x3fff_ffff), 0.0, 0.0]).collect();
+    let gpu = sylva_gpu::trunk_noise::trunk_noise(ctx, &noise.bands, &s).unwrap();
+    let mut cpu = vec![[0.0f32; 4]; s.len()];
+    sylva_core::cpu::trunk_noise(&noise.bands, &s, &mut cpu);
+    let mut worst = 0.0f32;
+    for i in 0..s.len() {
+        for a in 0..3 {
+            worst = worst.max((gpu[i][a] - cpu[i][a]).abs());
+        }
+    }
+    println!("trunk noise worst |Δ| = {worst:e} rad (static bend {} rad)", noise.static_bend);
+    assert!(worst <= 1e-6, "{worst}");
+}
+
+#[test]
+fn kernel_timing_is_reported() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = WindScene { fields: vec![WindField::Constant(Constant { direction: [1.0, 0.0, 0.0], speed: 3.0 })] };
+    let sampler = sylva_gpu::wind_sample::WindSampler::new(ctx, &scene).unwrap();
+    let (v, timing) = sampler.sample_timed(ctx, &samples(3)[..10_000]).unwrap();
+    assert_eq!(v[0][0], 3.0);
+    assert!(timing.wall.as_nanos() > 0);
+    if ctx.timestamps {
+        assert!(timing.gpu.is_some(), "adapter has timestamp queries but none were read");
+    }
+    println!("10k samples: {:?} (timestamps: {})", timing, ctx.timestamps);
+}
