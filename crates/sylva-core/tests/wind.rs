@@ -1,0 +1,287 @@
+//! Wind fields: the papers' formulas at hand-computed points, the physics each primitive
+//! promises, the turbulence spectrum, TOML round trips and errors.
+
+use glam::Vec3;
+use sylva_core::wind::trunk::TrunkNoise;
+use sylva_core::wind::*;
+
+fn one(f: WindField) -> WindScene {
+    WindScene { fields: vec![f] }
+}
+
+fn two_waves(sharpness: Option<f32>) -> WindScene {
+    one(WindField::SumOfSines(SumOfSines {
+        waves: vec![
+            SineWave { amplitude: 2.0, direction_deg: 30.0, wavelength: 10.0, speed: 3.0 },
+            SineWave { amplitude: 1.0, direction_deg: 120.0, wavelength: 25.0, speed: 5.0 },
+        ],
+        sharpness,
+    }))
+}
+
+/// Skjermo eq. 13 at (x, z) = (1, 2), t = 0.5, by hand:
+/// wave 1: D = (cos 30°, sin 30°) = (0.866025, 0.5), w = 2π/10 = 0.628319, φ = 3w = 1.884956,
+///   θ₁ = (0.866025·1 + 0.5·2)·0.628319 + 0.5·1.884956 = 2.114936, sin θ₁ = 0.855573;
+/// wave 2: D = (−0.5, 0.866025), w = 2π/25 = 0.251327, φ = 5w = 1.256637,
+///   θ₂ = (−0.5 + 1.732051)·0.251327 + 0.5·1.256637 = 0.937967, sin θ₂ = 0.806357;
+/// F = D₁·2·0.855573 + D₂·1·0.806357 = (1.078717, 0, 1.553899).
+#[test]
+fn sum_of_sines_reproduces_eq_13() {
+    let v = two_waves(None).sample(Vec3::new(1.0, 7.0, 2.0), 0.5);
+    assert!((v - Vec3::new(1.078717, 0.0, 1.553899)).length() < 2e-5, "{v}");
+}
+
+/// Eq. 14 with k = 2 at the same point: F = Σ Dᵢ Aᵢ ((sin θᵢ + 1)/2)²
+/// = D₁·2·0.927787² + D₂·1·0.903179² = (1.083062, 0, 1.567232).
+#[test]
+fn sum_of_sines_reproduces_eq_14() {
+    let v = two_waves(Some(2.0)).sample(Vec3::new(1.0, 0.0, 2.0), 0.5);
+    assert!((v - Vec3::new(1.083062, 0.0, 1.567232)).length() < 2e-5, "{v}");
+}
+
+#[test]
+fn sharpness_above_one_sharpens_peaks_and_flattens_troughs() {
+    let wave = |k: f32| {
+        one(WindField::SumOfSines(SumOfSines {
+            waves: vec![SineWave { amplitude: 1.0, direction_deg: 0.0, wavelength: 10.0, speed: 10.0 }],
+            sharpness: Some(k),
+        }))
+    };
+    // One period (1 s) at the origin, 10,000 samples.
+    let series = |k: f32| -> Vec<f32> { (0..10_000).map(|i| wave(k).sample(Vec3::ZERO, i as f32 * 1e-4).x).collect() };
+    let (s1, s4) = (series(1.0), series(4.0));
+    let frac = |s: &[f32], f: &dyn Fn(f32) -> bool| s.iter().filter(|v| f(**v)).count() as f32 / s.len() as f32;
+    // Same peak (A) and floor (0)...
+    for s in [&s1, &s4] {
+        assert!((s.iter().cloned().fold(f32::MIN, f32::max) - 1.0).abs() < 1e-4);
+        assert!(s.iter().cloned().fold(f32::MAX, f32::min).abs() < 1e-4);
+    }
+    // ...but narrower peaks: less time above half the peak,
+    let (h1, h4) = (frac(&s1, &|v| v > 0.5), frac(&s4, &|v| v > 0.5));
+    assert!((h1 - 0.5).abs() < 0.01 && h4 < 0.3, "{h1} {h4}");
+    // and flatter, wider troughs: more time near zero.
+    let (t1, t4) = (frac(&s1, &|v| v < 0.05), frac(&s4, &|v| v < 0.05));
+    assert!(t4 > 2.0 * t1, "{t1} {t4}");
+}
+
+#[test]
+fn gust_front_arrives_downstream_later_by_distance_over_speed() {
+    let speed = 8.0;
+    let scene = one(WindField::GustFront(GustFront {
+        origin: [0.0, 0.0],
+        direction_deg: 45.0,
+        strength: 12.0,
+        speed,
+        width: 10.0,
+        length: 60.0,
+        radius: 500.0,
+        start: 2.0,
+    }));
+    let dir = Vec3::new(45f32.to_radians().cos(), 0.0, 45f32.to_radians().sin());
+    // First time the wind reaches half strength at a point `d` metres downstream.
+    let arrival = |d: f32| -> f32 {
+        let p = dir * d + Vec3::new(0.0, 3.0, 0.0);
+        let mut t = 0.0;
+        while scene.sample(p, t).length() < 6.0 {
+            t += 1e-3;
+            assert!(t < 100.0);
+        }
+        t
+    };
+    let (a20, a60, a140) = (arrival(20.0), arrival(60.0), arrival(140.0));
+    assert!((a60 - a20 - 40.0 / speed).abs() < 2e-3, "{a20} {a60}");
+    assert!((a140 - a20 - 120.0 / speed).abs() < 2e-3, "{a20} {a140}");
+    // Half strength is reached half-way up the rising edge (width 10 m): 5 m before the front.
+    assert!((a20 - (2.0 + (20.0 - 5.0) / speed)).abs() < 2e-3, "{a20}");
+    // The wind blows along the front's direction.
+    let v = scene.sample(dir * 20.0, a20 + 1.0);
+    assert!(v.normalize().dot(dir) > 0.9999);
+}
+
+#[test]
+fn vortex_turns_about_a_vertical_axis_with_peak_speed_at_its_radius() {
+    let scene = one(WindField::Vortex(Vortex {
+        centre: [10.0, -5.0],
+        drift: [0.0, 0.0],
+        strength: 15.0,
+        radius: 8.0,
+        updraft: 2.0,
+        start: 1.0,
+        duration: 20.0,
+        fade: 2.0,
+    }));
+    let c = Vec3::new(10.0, 0.0, -5.0);
+    let t = 10.0;
+    let speed_at = |r: f32| scene.sample(c + Vec3::X * r, t).with_y(0.0).length();
+    let peak_r = (1..400).map(|i| i as f32 * 0.1).max_by(|a, b| speed_at(*a).total_cmp(&speed_at(*b))).unwrap();
+    assert!((peak_r - 8.0).abs() < 0.15, "{peak_r}");
+    assert!((speed_at(8.0) - 15.0).abs() < 0.05, "{}", speed_at(8.0));
+    // Tangential everywhere (no radial component), counter-clockwise seen from above.
+    for a in 0..12 {
+        let ang = a as f32 * 0.5;
+        let r = Vec3::new(ang.cos(), 0.0, ang.sin()) * 5.0;
+        let v = scene.sample(c + r, t).with_y(0.0);
+        assert!(v.dot(r).abs() < 1e-4 * v.length() * 5.0);
+        assert!(Vec3::Y.dot(r.cross(v)) > 0.0, "not counter-clockwise");
+    }
+    // Updraft at the centre; nothing before it starts or after it ends.
+    assert!((scene.sample(c, t).y - 2.0).abs() < 1e-4);
+    assert_eq!(scene.sample(c + Vec3::X * 8.0, 0.5), Vec3::ZERO);
+    assert_eq!(scene.sample(c + Vec3::X * 8.0, 21.5), Vec3::ZERO);
+}
+
+#[test]
+fn blast_expands_outward_and_decays() {
+    let scene = one(WindField::Blast(Blast {
+        centre: [0.0, 1.0, 0.0],
+        strength: 40.0,
+        start: 3.0,
+        speed: 50.0,
+        width: 4.0,
+        decay: 2.0,
+        radius: 300.0,
+    }));
+    let c = Vec3::new(0.0, 1.0, 0.0);
+    let dir = Vec3::new(0.6, 0.0, 0.8);
+    for tau in [0.5f32, 1.0, 2.0] {
+        let peak = (1..2000).map(|i| i as f32 * 0.1).max_by(|a, b| scene.sample(c + dir * *a, 3.0 + tau).length().total_cmp(&scene.sample(c + dir * *b, 3.0 + tau).length())).unwrap();
+        assert!((peak - 50.0 * tau).abs() < 0.2, "tau {tau}: shell at {peak}");
+        let v = scene.sample(c + dir * peak, 3.0 + tau);
+        assert!(v.normalize().dot(dir) > 0.9999, "not outward");
+        assert!((v.length() - 40.0 * (-tau / 2.0).exp()).abs() < 0.05);
+    }
+    assert_eq!(scene.sample(c + dir * 10.0, 2.9), Vec3::ZERO);
+    assert_eq!(scene.sample(c + dir * 350.0, 3.0 + 7.0), Vec3::ZERO);
+}
+
+/// Log-log slope of the temporal power spectrum of turbulence at one point, by FFT of a
+/// long series and a least-squares fit over log-spaced bins inside [f_min, f_max].
+fn spectral_slope(beta: f32) -> f64 {
+    use rustfft::{FftPlanner, num_complex::Complex};
+    let turb = Turbulence { intensity: 2.0, beta, f_min: 0.005, f_max: 5.0, components: 512, mean_speed: 5.0, vertical: 0.3, seed: 3 };
+    let (fields, waves) = one(WindField::Turbulence(turb)).pack();
+    let n = 1 << 17;
+    let dt = 0.04f64;
+    let p = Vec3::new(3.0, 10.0, -7.0);
+    let mut buf: Vec<Complex<f64>> = (0..n)
+        .map(|i| Complex::new(sylva_core::cpu::wind_sample::wind_at(&fields, &waves, p, (i as f64 * dt) as f32).x as f64, 0.0))
+        .collect();
+    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
+    let df = 1.0 / (n as f64 * dt);
+    // Bins of 0.1 decade from 0.02 to 3 Hz.
+    let (lo, hi) = (0.02f64.log10(), 3.0f64.log10());
+    let nb = ((hi - lo) / 0.1).round() as usize;
+    let mut pts = Vec::new();
+    for b in 0..nb {
+        let (f0, f1) = (10f64.powf(lo + b as f64 * 0.1), 10f64.powf(lo + (b + 1) as f64 * 0.1));
+        let (k0, k1) = ((f0 / df).ceil() as usize, (f1 / df).floor() as usize);
+        let power: f64 = (k0..=k1).map(|k| buf[k].norm_sqr()).sum();
+        pts.push(((0.5 * (f0 + f1)).log10(), (power / (f1 - f0)).log10()));
+    }
+    let m = pts.len() as f64;
+    let (sx, sy) = (pts.iter().map(|p| p.0).sum::<f64>(), pts.iter().map(|p| p.1).sum::<f64>());
+    let sxx = pts.iter().map(|p| p.0 * p.0).sum::<f64>();
+    let sxy = pts.iter().map(|p| p.0 * p.1).sum::<f64>();
+    (m * sxy - sx * sy) / (m * sxx - sx * sx)
+}
+
+#[test]
+fn turbulence_spectrum_follows_one_over_f_to_the_beta() {
+    for beta in [1.0f32, 5.0 / 3.0, 2.0] {
+        let slope = spectral_slope(beta);
+        println!("β = {beta:.3}: fitted slope {slope:.3}");
+        assert!((slope + beta as f64).abs() < 0.1, "β = {beta}: slope {slope}");
+    }
+}
+
+#[test]
+fn turbulence_has_the_requested_intensity_and_is_spatially_coherent() {
+    let turb = Turbulence { intensity: 1.5, beta: 5.0 / 3.0, f_min: 0.01, f_max: 5.0, components: 64, mean_speed: 5.0, vertical: 0.3, seed: 9 };
+    let scene = one(WindField::Turbulence(turb));
+    let (f, w) = scene.pack();
+    let at = |p: Vec3, t: f32| sylva_core::cpu::wind_sample::wind_at(&f, &w, p, t);
+    let n = 200_000;
+    let rms = ((0..n).map(|i| at(Vec3::ZERO, i as f32 * 0.05).x.powi(2) as f64).sum::<f64>() / n as f64).sqrt();
+    assert!((rms - 1.5).abs() < 0.2, "rms {rms}");
+    // Nearby points move together, distant ones do not.
+    let corr = |d: f32| {
+        let (mut ab, mut aa, mut bb) = (0.0f64, 0.0f64, 0.0f64);
+        for i in 0..20_000 {
+            let t = i as f32 * 0.1;
+            let (a, b) = (at(Vec3::ZERO, t).x as f64, at(Vec3::new(d, 0.0, 0.0), t).x as f64);
+            ab += a * b;
+            aa += a * a;
+            bb += b * b;
+        }
+        ab / (aa * bb).sqrt()
+    };
+    assert!(corr(0.5) > 0.95, "{}", corr(0.5));
+    assert!(corr(2000.0).abs() < 0.5, "{}", corr(2000.0));
+}
+
+#[test]
+fn scenes_round_trip_through_toml() {
+    let text = include_str!("../../../presets/wind/gusty.toml");
+    let scene = WindScene::from_toml(text, "gusty.toml").unwrap();
+    assert!(scene.fields.len() >= 4);
+    let again = WindScene::from_toml(&scene.to_toml(), "again.toml").unwrap();
+    assert_eq!(scene, again);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("w.toml");
+    scene.save(&path).unwrap();
+    assert_eq!(WindScene::load(&path).unwrap(), scene);
+    // Sampling is the sum of the fields.
+    let p = Vec3::new(3.0, 4.0, 5.0);
+    let sum: Vec3 = scene.fields.iter().map(|f| one(f.clone()).sample(p, 12.0)).sum();
+    assert!((scene.sample(p, 12.0) - sum).length() < 1e-4);
+}
+
+#[test]
+fn bad_scenes_name_the_line_and_field() {
+    let e = WindScene::from_toml("[[field]]\nkind = \"constant\"\ndirection = [1, 0, 0]\nspeed = 3\ngustiness = 2\n", "w.toml").unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.starts_with("w.toml:") && msg.contains("gustiness"), "{msg}");
+    let e = WindScene::from_toml("[[field]]\nkind = \"hurricane\"\n", "w.toml").unwrap_err().to_string();
+    assert!(e.contains("hurricane"), "{e}");
+    let e = WindScene::from_toml("[[field]]\nkind = \"constant\"\ndirection = [1, 0, 0]\nspeed = nan\n", "w.toml").unwrap_err().to_string();
+    assert!(e.contains("field[0].speed"), "{e}");
+    let e = WindScene::from_toml(
+        "[[field]]\nkind = \"constant\"\ndirection = [1, 0, 0]\nspeed = 1\n[[field]]\nkind = \"turbulence\"\nintensity = 1\ncomponents = 100000\n",
+        "w.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("field[1].components"), "{e}");
+}
+
+#[test]
+fn trunk_noise_follows_size_and_stiffness() {
+    let slender = TrunkNoise::new(0.10, 12.0, 40.0, 8.0, 8e9, 800.0, 12.0);
+    let stout = TrunkNoise::new(0.25, 12.0, 40.0, 8.0, 8e9, 800.0, 12.0);
+    assert!(stout.natural_frequency > slender.natural_frequency);
+    assert!(stout.static_bend < slender.static_bend);
+    let tall = TrunkNoise::new(0.10, 24.0, 40.0, 8.0, 8e9, 800.0, 12.0);
+    assert!(tall.natural_frequency < slender.natural_frequency / 3.0);
+    // Stronger wind bends more (∝ U²); calm air does not move the trunk.
+    let calm = TrunkNoise::new(0.10, 12.0, 40.0, 8.0, 8e9, 800.0, 0.0);
+    assert_eq!(calm.angles(3.0, 1), [0.0; 3]);
+    let gale = TrunkNoise::new(0.10, 12.0, 40.0, 8.0, 8e9, 800.0, 24.0);
+    assert!((gale.static_bend / slender.static_bend - 4.0).abs() < 1e-3 || gale.static_bend == 0.35);
+    // Parallel motion leans away from the wind on average and dominates the other axes;
+    // trees with different seeds move differently.
+    let n = 20_000;
+    let mut mean = [0.0f64; 3];
+    let mut sq = [0.0f64; 3];
+    for i in 0..n {
+        let a = slender.angles(i as f32 * 0.05, 7);
+        for k in 0..3 {
+            mean[k] += a[k] as f64 / n as f64;
+            sq[k] += (a[k] as f64).powi(2) / n as f64;
+        }
+    }
+    let theta = slender.static_bend as f64;
+    assert!((mean[0] - 0.8 * theta).abs() < 0.15 * theta, "{mean:?} θ {theta}");
+    let sd = |k: usize| (sq[k] - mean[k] * mean[k]).sqrt();
+    assert!(sd(0) > sd(1) && sd(1) > sd(2), "{} {} {}", sd(0), sd(1), sd(2));
+    assert_ne!(slender.angles(10.0, 1), slender.angles(10.0, 2));
+}
