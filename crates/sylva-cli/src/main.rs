@@ -3,6 +3,8 @@
 //! With no arguments, runs the main job on the built-in default scene. Until the renderer
 //! lands that is `sylva generate` on the default species.
 
+mod wind_cmd;
+
 use anyhow::{Context, Result};
 
 use clap::{Parser, Subcommand};
@@ -25,6 +27,8 @@ enum Command {
     Generate(GenerateArgs),
     /// List the species and grammars that ship with Sylva.
     Presets,
+    /// Plot a wind scene: speed at a point over time, and a top-down map of the field.
+    Wind(wind_cmd::WindArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -65,6 +69,12 @@ fn main() -> Result<()> {
         Some(Command::Generate(args)) => generate(args),
         Some(Command::Presets) => {
             presets();
+            Ok(())
+        }
+        Some(Command::Wind(args)) => {
+            for p in wind_cmd::run(&args)? {
+                println!("wrote {}", p.display());
+            }
             Ok(())
         }
     }

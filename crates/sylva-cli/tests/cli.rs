@@ -73,3 +73,62 @@ fn bad_input_gives_a_located_error_and_no_file() {
     assert!(!ok);
     assert!(err.contains("nope") && err.contains("weeping_willow"), "{err}");
 }
+
+fn png_size(path: &std::path::Path) -> (u32, u32) {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{} is not a PNG", path.display());
+    (u32::from_be_bytes(bytes[16..20].try_into().unwrap()), u32::from_be_bytes(bytes[20..24].try_into().unwrap()))
+}
+
+#[test]
+fn wind_writes_a_speed_plot_and_a_field_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = sylva(dir.path(), &["wind", "--scene", "gusty", "--to", "20", "--out-dir", "plots"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("wind_speed.png") && out.contains("wind_field.png"), "{out}");
+    assert_eq!(png_size(&dir.path().join("plots/wind_speed.png")), (1200, 600));
+    assert_eq!(png_size(&dir.path().join("plots/wind_field.png")), (900, 900));
+    // A scene from a file.
+    std::fs::write(dir.path().join("w.toml"), "[[field]]\nkind = \"constant\"\ndirection = [0, 0, 1]\nspeed = 4\n")
+        .unwrap();
+    let (ok, _, err) = sylva(dir.path(), &["wind", "--scene", "w.toml", "--out-dir", "w"]);
+    assert!(ok, "{err}");
+    assert!(dir.path().join("w/wind_field.png").exists());
+}
+
+#[test]
+fn wind_rejects_bad_input_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("bad.toml"), "[[field]]\nkind = \"constant\"\nspeed = 4\n").unwrap();
+    let (ok, _, err) = sylva(dir.path(), &["wind", "--scene", "bad.toml"]);
+    assert!(!ok);
+    assert!(err.contains("bad.toml") && err.contains("direction"), "{err}");
+    let (ok, _, err) = sylva(dir.path(), &["wind", "--from", "5", "--to", "1"]);
+    assert!(!ok && err.contains("--to"), "{err}");
+    let (ok, _, err) = sylva(dir.path(), &["wind", "--point", "1,2"]);
+    assert!(!ok && err.contains("x,y,z"), "{err}");
+    let (ok, _, err) = sylva(dir.path(), &["wind", "--scene", "nowhere"]);
+    assert!(!ok && err.contains("gusty"), "{err}");
+    assert!(!dir.path().join("out").exists());
+}
+
+#[test]
+fn wind_on_the_gpu_draws_the_same_field() {
+    if sylva_gpu::GpuContext::shared().is_err() {
+        assert!(std::env::var("CI").is_err(), "CI requires a GPU adapter");
+        eprintln!("skipping: no GPU adapter");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, _, err) =
+        sylva(dir.path(), &["wind", "--scene", "blast", "--backend", "gpu", "--time", "2.5", "--out-dir", "g"]);
+    assert!(ok, "{err}");
+    let (ok, _, err) =
+        sylva(dir.path(), &["wind", "--scene", "blast", "--backend", "cpu", "--time", "2.5", "--out-dir", "c"]);
+    assert!(ok, "{err}");
+    // Identical numbers within the kernels' tolerance draw identical pictures.
+    assert_eq!(
+        std::fs::read(dir.path().join("g/wind_field.png")).unwrap(),
+        std::fs::read(dir.path().join("c/wind_field.png")).unwrap()
+    );
+}

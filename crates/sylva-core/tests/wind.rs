@@ -144,7 +144,15 @@ fn blast_expands_outward_and_decays() {
     let c = Vec3::new(0.0, 1.0, 0.0);
     let dir = Vec3::new(0.6, 0.0, 0.8);
     for tau in [0.5f32, 1.0, 2.0] {
-        let peak = (1..2000).map(|i| i as f32 * 0.1).max_by(|a, b| scene.sample(c + dir * *a, 3.0 + tau).length().total_cmp(&scene.sample(c + dir * *b, 3.0 + tau).length())).unwrap();
+        let peak = (1..2000)
+            .map(|i| i as f32 * 0.1)
+            .max_by(|a, b| {
+                scene
+                    .sample(c + dir * *a, 3.0 + tau)
+                    .length()
+                    .total_cmp(&scene.sample(c + dir * *b, 3.0 + tau).length())
+            })
+            .unwrap();
         assert!((peak - 50.0 * tau).abs() < 0.2, "tau {tau}: shell at {peak}");
         let v = scene.sample(c + dir * peak, 3.0 + tau);
         assert!(v.normalize().dot(dir) > 0.9999, "not outward");
@@ -158,13 +166,27 @@ fn blast_expands_outward_and_decays() {
 /// long series and a least-squares fit over log-spaced bins inside [f_min, f_max].
 fn spectral_slope(beta: f32) -> f64 {
     use rustfft::{FftPlanner, num_complex::Complex};
-    let turb = Turbulence { intensity: 2.0, beta, f_min: 0.005, f_max: 5.0, components: 512, mean_speed: 5.0, vertical: 0.3, seed: 3 };
+    let turb = Turbulence {
+        intensity: 2.0,
+        beta,
+        f_min: 0.005,
+        f_max: 5.0,
+        components: 512,
+        mean_speed: 5.0,
+        vertical: 0.3,
+        seed: 3,
+    };
     let (fields, waves) = one(WindField::Turbulence(turb)).pack();
     let n = 1 << 17;
     let dt = 0.04f64;
     let p = Vec3::new(3.0, 10.0, -7.0);
     let mut buf: Vec<Complex<f64>> = (0..n)
-        .map(|i| Complex::new(sylva_core::cpu::wind_sample::wind_at(&fields, &waves, p, (i as f64 * dt) as f32).x as f64, 0.0))
+        .map(|i| {
+            Complex::new(
+                sylva_core::cpu::wind_sample::wind_at(&fields, &waves, p, (i as f64 * dt) as f32).x as f64,
+                0.0,
+            )
+        })
         .collect();
     FftPlanner::new().plan_fft_forward(n).process(&mut buf);
     let df = 1.0 / (n as f64 * dt);
@@ -196,7 +218,16 @@ fn turbulence_spectrum_follows_one_over_f_to_the_beta() {
 
 #[test]
 fn turbulence_has_the_requested_intensity_and_is_spatially_coherent() {
-    let turb = Turbulence { intensity: 1.5, beta: 5.0 / 3.0, f_min: 0.01, f_max: 5.0, components: 64, mean_speed: 5.0, vertical: 0.3, seed: 9 };
+    let turb = Turbulence {
+        intensity: 1.5,
+        beta: 5.0 / 3.0,
+        f_min: 0.01,
+        f_max: 5.0,
+        components: 64,
+        mean_speed: 5.0,
+        vertical: 0.3,
+        seed: 9,
+    };
     let scene = one(WindField::Turbulence(turb));
     let (f, w) = scene.pack();
     let at = |p: Vec3, t: f32| sylva_core::cpu::wind_sample::wind_at(&f, &w, p, t);
@@ -238,12 +269,18 @@ fn scenes_round_trip_through_toml() {
 
 #[test]
 fn bad_scenes_name_the_line_and_field() {
-    let e = WindScene::from_toml("[[field]]\nkind = \"constant\"\ndirection = [1, 0, 0]\nspeed = 3\ngustiness = 2\n", "w.toml").unwrap_err();
+    let e = WindScene::from_toml(
+        "[[field]]\nkind = \"constant\"\ndirection = [1, 0, 0]\nspeed = 3\ngustiness = 2\n",
+        "w.toml",
+    )
+    .unwrap_err();
     let msg = e.to_string();
     assert!(msg.starts_with("w.toml:") && msg.contains("gustiness"), "{msg}");
     let e = WindScene::from_toml("[[field]]\nkind = \"hurricane\"\n", "w.toml").unwrap_err().to_string();
     assert!(e.contains("hurricane"), "{e}");
-    let e = WindScene::from_toml("[[field]]\nkind = \"constant\"\ndirection = [1, 0, 0]\nspeed = nan\n", "w.toml").unwrap_err().to_string();
+    let e = WindScene::from_toml("[[field]]\nkind = \"constant\"\ndirection = [1, 0, 0]\nspeed = nan\n", "w.toml")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("field[0].speed"), "{e}");
     let e = WindScene::from_toml(
         "[[field]]\nkind = \"constant\"\ndirection = [1, 0, 0]\nspeed = 1\n[[field]]\nkind = \"turbulence\"\nintensity = 1\ncomponents = 100000\n",

@@ -112,10 +112,19 @@ impl Kernel {
     /// Dispatches once, submits and waits, timing the kernel: with timestamp queries when
     /// the device has them (GPU time of the pass), and always by wall clock from submit to
     /// completion.
-    pub fn run_timed(&self, ctx: &GpuContext, buffers: &[&wgpu::Buffer], invocations: u32) -> Result<KernelTiming, GpuError> {
+    pub fn run_timed(
+        &self,
+        ctx: &GpuContext,
+        buffers: &[&wgpu::Buffer],
+        invocations: u32,
+    ) -> Result<KernelTiming, GpuError> {
         let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(self.name) });
         let queries = ctx.timestamps.then(|| {
-            let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("kernel timing"), ty: wgpu::QueryType::Timestamp, count: 2 });
+            let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("kernel timing"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            });
             let resolve = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("timestamps"),
                 size: 16,

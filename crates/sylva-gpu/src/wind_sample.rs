@@ -23,7 +23,8 @@ impl WindSampler {
 
     /// From packed fields and waves. An empty scene is bound as one zero constant field.
     pub fn from_raw(ctx: &GpuContext, fields: &[RawField], waves: &[RawWave]) -> Result<Self, GpuError> {
-        let zero_field = [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
+        let zero_field =
+            [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
         let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
         let fields = upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { fields })?;
         let waves = upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { waves })?;
@@ -36,7 +37,11 @@ impl WindSampler {
     }
 
     /// [`Self::sample`], with the kernel's timing (upload and readback excluded).
-    pub fn sample_timed(&self, ctx: &GpuContext, samples: &[[f32; 4]]) -> Result<(Vec<[f32; 4]>, KernelTiming), GpuError> {
+    pub fn sample_timed(
+        &self,
+        ctx: &GpuContext,
+        samples: &[[f32; 4]],
+    ) -> Result<(Vec<[f32; 4]>, KernelTiming), GpuError> {
         let input = upload(ctx, "wind samples", samples)?;
         let out = output::<[f32; 4]>(ctx, "wind velocities", samples.len())?;
         let timing = self.kernel.run_timed(ctx, &[&self.fields, &self.waves, &input, &out], samples.len() as u32)?;

@@ -14,7 +14,12 @@ fn samples(seed: u64) -> Vec<[f32; 4]> {
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
     (0..SAMPLES)
         .map(|_| {
-            [rng.random_range(-150.0..150.0), rng.random_range(0.0..40.0), rng.random_range(-150.0..150.0), rng.random_range(0.0..120.0)]
+            [
+                rng.random_range(-150.0..150.0),
+                rng.random_range(0.0..40.0),
+                rng.random_range(-150.0..150.0),
+                rng.random_range(0.0..120.0),
+            ]
         })
         .collect()
 }
@@ -32,7 +37,12 @@ fn scenes(rng: &mut rand::rngs::StdRng) -> Vec<(&'static str, WindScene, f32, f3
     let constant = Constant { direction: [r(-1.0, 1.0), r(-0.2, 0.2), r(-1.0, 1.0)], speed: r(1.0, 20.0) };
     let peak_c = constant.speed;
     let waves: Vec<SineWave> = (0..4)
-        .map(|_| SineWave { amplitude: r(0.5, 4.0), direction_deg: r(0.0, 360.0), wavelength: r(5.0, 80.0), speed: r(1.0, 10.0) })
+        .map(|_| SineWave {
+            amplitude: r(0.5, 4.0),
+            direction_deg: r(0.0, 360.0),
+            wavelength: r(5.0, 80.0),
+            speed: r(1.0, 10.0),
+        })
         .collect();
     let peak_s: f32 = waves.iter().map(|w| w.amplitude).sum();
     let sines = SumOfSines { waves: waves.clone(), sharpness: None };
@@ -140,8 +150,9 @@ fn trunk_noise_matches_on_a_million_samples() {
     let Some(ctx) = common::gpu() else { return };
     let noise = TrunkNoise::new(0.12, 13.0, 50.0, 8.0, 8e9, 800.0, 15.0);
     let mut rng = rand::rngs::StdRng::seed_from_u64(5);
-    let s: Vec<[f32; 4]> =
-        (0..SAMPLES).map(|_| [rng.random_range(0.0..600.0), f32::from_bits(rng.random::<u32>() & 0x3fff_ffff), 0.0, 0.0]).collect();
+    let s: Vec<[f32; 4]> = (0..SAMPLES)
+        .map(|_| [rng.random_range(0.0..600.0), f32::from_bits(rng.random::<u32>() & 0x3fff_ffff), 0.0, 0.0])
+        .collect();
     let gpu = sylva_gpu::trunk_noise::trunk_noise(ctx, &noise.bands, &s).unwrap();
     let mut cpu = vec![[0.0f32; 4]; s.len()];
     sylva_core::cpu::trunk_noise(&noise.bands, &s, &mut cpu);

@@ -230,6 +230,30 @@ pub enum WindError {
     Io { file: String, message: String },
 }
 
+/// Wind scenes shipped in `presets/wind/`: (name, file, text).
+pub const PRESETS: &[(&str, &str, &str)] = &[
+    ("gusty", "presets/wind/gusty.toml", include_str!("../../../../presets/wind/gusty.toml")),
+    ("blast", "presets/wind/blast.toml", include_str!("../../../../presets/wind/blast.toml")),
+];
+
+impl WindScene {
+    /// A preset name (`gusty`, `blast`) or a TOML file path.
+    pub fn resolve(arg: &str) -> Result<Self, WindError> {
+        if let Some((_, file, text)) = PRESETS.iter().find(|p| p.0 == arg) {
+            return Self::from_toml(text, file);
+        }
+        let path = Path::new(arg);
+        if !path.exists() {
+            let names: Vec<&str> = PRESETS.iter().map(|p| p.0).collect();
+            return Err(WindError::Io {
+                file: arg.to_string(),
+                message: format!("no such file or wind preset (presets: {})", names.join(", ")),
+            });
+        }
+        Self::load(path)
+    }
+}
+
 /// Largest number of waves in one sum of sines or turbulence field.
 pub const MAX_WAVES: u32 = 4096;
 
@@ -248,7 +272,12 @@ impl WindScene {
             let column = before.rfind('\n').map_or(before.len(), |i| before.len() - i - 1) + 1;
             WindError::Toml { file: file.to_string(), line, column, message: e.message().trim().to_string() }
         })?;
-        scene.check().map_err(|(index, field, message)| WindError::Value { file: file.to_string(), index, field, message })?;
+        scene.check().map_err(|(index, field, message)| WindError::Value {
+            file: file.to_string(),
+            index,
+            field,
+            message,
+        })?;
         Ok(scene)
     }
 
@@ -370,7 +399,15 @@ impl WindScene {
         let mut fields = Vec::with_capacity(self.fields.len());
         let mut waves = Vec::new();
         for f in &self.fields {
-            let mut r = RawField { kind: 0, wave_offset: waves.len() as u32, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] };
+            let mut r = RawField {
+                kind: 0,
+                wave_offset: waves.len() as u32,
+                wave_count: 0,
+                _pad: 0,
+                a: [0.0; 4],
+                b: [0.0; 4],
+                c: [0.0; 4],
+            };
             match f {
                 WindField::Constant(c) => {
                     r.kind = kind::CONSTANT;

@@ -58,7 +58,15 @@ impl TrunkNoise {
     /// Bands for a tree with trunk base radius `radius` (m), height `height` (m), crown area
     /// `crown_area` (m²) centred at `crown_height` (m), wood E (Pa) and ρ (kg/m³), in a mean
     /// wind of `wind_speed` (m/s).
-    pub fn new(radius: f32, height: f32, crown_area: f32, crown_height: f32, young: f32, density: f32, wind_speed: f32) -> Self {
+    pub fn new(
+        radius: f32,
+        height: f32,
+        crown_area: f32,
+        crown_height: f32,
+        young: f32,
+        density: f32,
+        wind_speed: f32,
+    ) -> Self {
         let r = radius.max(1e-4);
         let h = height.max(0.1);
         let ei = young * std::f32::consts::FRAC_PI_4 * r.powi(4);
@@ -110,7 +118,15 @@ impl TrunkNoise {
         let crown_base = if crown_base.is_finite() { crown_base } else { lo.y + 0.5 * height };
         let crown_h = (hi.y - crown_base).max(0.1);
         let width = (hi.x - lo.x).max(hi.z - lo.z).max(0.1);
-        Self::new(radius, height, crown_h * width, 0.5 * (crown_base + hi.y) - lo.y, tree.wood.young_modulus, tree.wood.density, wind_speed)
+        Self::new(
+            radius,
+            height,
+            crown_h * width,
+            0.5 * (crown_base + hi.y) - lo.y,
+            tree.wood.young_modulus,
+            tree.wood.density,
+            wind_speed,
+        )
     }
 
     /// (parallel, perpendicular, twist) at time `t` for a tree with phase seed `tree_seed`.
