@@ -29,9 +29,32 @@ fn broken_wgsl_is_caught_without_a_gpu() {
     assert!(naga::front::wgsl::parse_str(&src).is_err());
 }
 
+#[test]
+fn every_wgsl_file_is_part_of_a_validated_kernel() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/shader");
+    let mut files = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "wgsl") {
+            files += 1;
+            let text = std::fs::read_to_string(&path).unwrap();
+            assert!(
+                KERNELS.iter().any(|(_, parts)| parts.contains(&text.as_str())),
+                "{} is in no kernel of shader::KERNELS, so nothing validates it",
+                path.display()
+            );
+        }
+    }
+    assert!(files >= 7);
+}
+
 /// (size, [(member, offset)]) of a WGSL struct, from naga's layouter.
 fn wgsl_layout(name: &str) -> (u32, Vec<(String, u32)>) {
-    let module = parse(TREE, "tree.wgsl");
+    wgsl_layout_in(TREE, name)
+}
+
+fn wgsl_layout_in(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+    let module = parse(src, name);
     let mut layouter = naga::proc::Layouter::default();
     layouter.update(module.to_ctx()).unwrap();
     for (handle, ty) in module.types.iter() {
@@ -42,11 +65,15 @@ fn wgsl_layout(name: &str) -> (u32, Vec<(String, u32)>) {
             }
         }
     }
-    panic!("no struct {name} in tree.wgsl");
+    panic!("no struct {name}");
 }
 
 fn check(name: &str, rust_size: usize, rust: &[(&str, usize)]) {
-    let (size, members) = wgsl_layout(name);
+    check_in(TREE, name, rust_size, rust)
+}
+
+fn check_in(src: &str, name: &str, rust_size: usize, rust: &[(&str, usize)]) {
+    let (size, members) = wgsl_layout_in(src, name);
     assert_eq!(size as usize, rust_size, "{name}: WGSL size {size}, Rust {rust_size}");
     assert_eq!(members.len(), rust.len(), "{name}: member count");
     for ((wname, woff), (rname, roff)) in members.iter().zip(rust) {
@@ -103,6 +130,47 @@ fn pod_structs_match_their_wgsl_twins() {
             ("length", offset_of!(RawLeaf, length)),
             ("segment", offset_of!(RawLeaf, segment)),
             ("_pad", offset_of!(RawLeaf, _pad)),
+        ],
+    );
+}
+
+#[test]
+fn wind_and_noise_structs_match_their_wgsl_twins() {
+    use sylva_core::wind::raw::{RawField, RawWave};
+    use sylva_core::wind::trunk::RawBand;
+    use sylva_gpu::shader::{NOISE, TRUNK_NOISE, WIND};
+    let wind = compose(&[NOISE, WIND]);
+    check_in(
+        &wind,
+        "Field",
+        size_of::<RawField>(),
+        &[
+            ("kind", offset_of!(RawField, kind)),
+            ("wave_offset", offset_of!(RawField, wave_offset)),
+            ("wave_count", offset_of!(RawField, wave_count)),
+            ("_pad", offset_of!(RawField, _pad)),
+            ("a", offset_of!(RawField, a)),
+            ("b", offset_of!(RawField, b)),
+            ("c", offset_of!(RawField, c)),
+        ],
+    );
+    check_in(
+        &wind,
+        "Wave",
+        size_of::<RawWave>(),
+        &[("dir", offset_of!(RawWave, dir)), ("k", offset_of!(RawWave, k)), ("phase", offset_of!(RawWave, phase))],
+    );
+    check_in(
+        &compose(&[NOISE, TRUNK_NOISE]),
+        "Band",
+        size_of::<RawBand>(),
+        &[
+            ("axis", offset_of!(RawBand, axis)),
+            ("seed", offset_of!(RawBand, seed)),
+            ("frequency", offset_of!(RawBand, frequency)),
+            ("amplitude", offset_of!(RawBand, amplitude)),
+            ("bias", offset_of!(RawBand, bias)),
+            ("_pad", offset_of!(RawBand, _pad)),
         ],
     );
 }
