@@ -49,10 +49,6 @@ fn every_wgsl_file_is_part_of_a_validated_kernel() {
 }
 
 /// (size, [(member, offset)]) of a WGSL struct, from naga's layouter.
-fn wgsl_layout(name: &str) -> (u32, Vec<(String, u32)>) {
-    wgsl_layout_in(TREE, name)
-}
-
 fn wgsl_layout_in(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
     let module = parse(src, name);
     let mut layouter = naga::proc::Layouter::default();
