@@ -13,6 +13,7 @@
 //! * [`species`]: the presets shipped in `presets/` and loading of user files.
 //! * [`export`]: static OBJ output, written atomically.
 
+pub mod animate;
 pub mod cpu;
 pub mod export;
 pub mod generate;

@@ -65,6 +65,10 @@ pub struct GpuContext {
     pub summary: AdapterSummary,
     /// Whether kernels can be timed with timestamp queries.
     pub timestamps: bool,
+    /// Compiled kernels by name: each is compiled once per context (see
+    /// [`crate::kernel::Kernel::cached`]).
+    pub(crate) kernels:
+        std::sync::Mutex<std::collections::HashMap<&'static str, std::sync::Arc<crate::kernel::Kernel>>>,
 }
 
 impl GpuContext {
@@ -105,7 +109,7 @@ impl GpuContext {
             trace: wgpu::Trace::Off,
         }))
         .map_err(|e| GpuError::Device { adapter: summary.name.clone(), message: e.to_string() })?;
-        Ok(Self { adapter, device, queue, summary, timestamps })
+        Ok(Self { adapter, device, queue, summary, timestamps, kernels: Default::default() })
     }
 
     /// One context shared by the whole process (tests, benchmarks, the CLI): created on

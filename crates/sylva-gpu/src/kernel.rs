@@ -57,6 +57,13 @@ impl Kernel {
         Self { name, pipeline, layout, max_groups_x: None }
     }
 
+    /// The kernel `name`, compiled on first use and shared after (shader compilation is the
+    /// slow part of setting a kernel up, seconds on a software rasteriser).
+    pub fn cached(ctx: &GpuContext, name: &'static str, sources: &[&str]) -> std::sync::Arc<Self> {
+        let mut map = ctx.kernels.lock().unwrap_or_else(|e| e.into_inner());
+        map.entry(name).or_insert_with(|| std::sync::Arc::new(Self::new(ctx, name, sources))).clone()
+    }
+
     /// Caps the workgroups in `x` below the device limit, so tests can exercise the spill
     /// into `y` without buffers of 4 million elements.
     pub fn with_max_groups_x(mut self, max: u32) -> Self {

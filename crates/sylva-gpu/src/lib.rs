@@ -13,6 +13,7 @@
 
 mod context;
 pub mod kernel;
+pub mod pose;
 pub mod segment_ends;
 pub mod shader;
 pub mod trunk_noise;

@@ -7,7 +7,7 @@ use sylva_core::wind::trunk::RawBand;
 
 /// Angles (parallel, perpendicular, twist, 0) at samples (t, tree seed bits, –, –).
 pub fn trunk_noise(ctx: &GpuContext, bands: &[RawBand], samples: &[[f32; 4]]) -> Result<Vec<[f32; 4]>, GpuError> {
-    let kernel = Kernel::new(ctx, "trunk_noise", &[NOISE, TRUNK_NOISE]);
+    let kernel = Kernel::cached(ctx, "trunk_noise", &[NOISE, TRUNK_NOISE]);
     let zero = [RawBand { axis: 0, seed: 0, frequency: 0.0, amplitude: 0.0, bias: 0.0, _pad: [0; 3] }];
     let b = upload(ctx, "bands", if bands.is_empty() { &zero } else { bands })?;
     let s = upload(ctx, "samples", samples)?;

@@ -9,7 +9,7 @@ use sylva_core::wind::raw::{RawField, RawWave};
 /// A scene uploaded once, sampled many times.
 #[derive(Debug)]
 pub struct WindSampler {
-    kernel: Kernel,
+    kernel: std::sync::Arc<Kernel>,
     fields: wgpu::Buffer,
     waves: wgpu::Buffer,
 }
@@ -28,7 +28,7 @@ impl WindSampler {
         let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
         let fields = upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { fields })?;
         let waves = upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { waves })?;
-        Ok(Self { kernel: Kernel::new(ctx, "wind_sample", &[NOISE, WIND, WIND_SAMPLE]), fields, waves })
+        Ok(Self { kernel: Kernel::cached(ctx, "wind_sample", &[NOISE, WIND, WIND_SAMPLE]), fields, waves })
     }
 
     /// Velocities (x, y, z, 0) at samples (x, y, z, t).

@@ -2,10 +2,13 @@
 //! their WGSL twins in `sylva-gpu/src/shader/` (`cpu::x` ↔ `shader/x.wgsl`).
 
 pub mod noise;
+pub mod pose_fk;
 mod segment_ends;
 pub mod trunk_noise;
 pub mod wind_sample;
+pub mod zioma_rotations;
 
 pub use segment_ends::segment_ends;
 pub use trunk_noise::trunk_noise;
 pub use wind_sample::wind_sample;
+pub use zioma_rotations::zioma_rotations;

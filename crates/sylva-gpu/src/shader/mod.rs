@@ -13,6 +13,12 @@ pub const WIND: &str = include_str!("wind.wgsl");
 pub const SEGMENT_ENDS: &str = include_str!("segment_ends.wgsl");
 /// Kernel: wind velocity at many (x, t) samples.
 pub const WIND_SAMPLE: &str = include_str!("wind_sample.wgsl");
+/// Kernel: accumulated rotations by ancestor walk (the pose seam).
+pub const POSE_ACCUMULATE: &str = include_str!("pose_accumulate.wgsl");
+/// Kernel: posed joint positions by ancestor walk (the pose seam).
+pub const POSE_POSITIONS: &str = include_str!("pose_positions.wgsl");
+/// Kernel: Zioma's per-segment rotations.
+pub const ZIOMA_ROTATIONS: &str = include_str!("zioma_rotations.wgsl");
 /// Kernel: trunk noise bands at many (t, tree) samples.
 pub const TRUNK_NOISE: &str = include_str!("trunk_noise.wgsl");
 
@@ -21,6 +27,9 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("segment_ends", &[QUAT, TREE, SEGMENT_ENDS]),
     ("wind_sample", &[NOISE, WIND, WIND_SAMPLE]),
     ("trunk_noise", &[NOISE, TRUNK_NOISE]),
+    ("pose_accumulate", &[QUAT, TREE, POSE_ACCUMULATE]),
+    ("pose_positions", &[QUAT, TREE, POSE_POSITIONS]),
+    ("zioma_rotations", &[QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS]),
 ];
 
 /// Concatenates WGSL sources into one module.

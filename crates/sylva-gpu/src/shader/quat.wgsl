@@ -15,3 +15,9 @@ fn quat_mul(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
         a.w * b.w - dot(a.xyz, b.xyz),
     );
 }
+
+// Rotation of `angle` radians about the unit `axis` (as glam's Quat::from_axis_angle).
+fn quat_axis_angle(axis: vec3<f32>, angle: f32) -> vec4<f32> {
+    let h = angle * 0.5;
+    return vec4<f32>(axis * sin(h), cos(h));
+}

@@ -1,0 +1,83 @@
+//! CPU twin of `shader/zioma_rotations.wgsl`: Zioma's per-segment rotations
+//! (see [`crate::animate::zioma`]). Bindings: 0 fields, 1 waves, 2 segments, 3 stems,
+//! 4 frame, 5 δ.
+
+use crate::animate::zioma::{RawZiomaFrame, RawZiomaStem};
+use crate::cpu::noise::value_noise;
+use crate::cpu::wind_sample::wind_at;
+use crate::model::RawSegment;
+use crate::wind::raw::{RawField, RawWave};
+use glam::{Quat, Vec3};
+use rayon::prelude::*;
+
+/// Unit axis or a fallback when the vector vanishes.
+#[inline]
+pub fn axis_or(v: Vec3, fallback: Vec3) -> Vec3 {
+    let l = v.length();
+    if l > 1e-6 { v / l } else { fallback }
+}
+
+/// Rotation of segment `s`.
+pub fn zioma_rotation(
+    fields: &[RawField],
+    waves: &[RawWave],
+    s: &RawSegment,
+    stem: &RawZiomaStem,
+    f: &RawZiomaFrame,
+) -> Quat {
+    let frac = s.length / stem.length;
+    let up = Vec3::Y;
+    if s.level == 0 {
+        let w = Vec3::from_array(f.wind_dir);
+        let par_axis = axis_or(up.cross(w), Vec3::X);
+        let perp_axis = axis_or(w, Vec3::Z);
+        return Quat::from_axis_angle(par_axis, f.trunk[0] * frac)
+            * Quat::from_axis_angle(perp_axis, f.trunk[1] * frac)
+            * Quat::from_axis_angle(up, f.trunk[2] * frac);
+    }
+    if f.lod == 0 {
+        return Quat::IDENTITY;
+    }
+    let base = Vec3::from_array(stem.base);
+    let v = wind_at(fields, waves, base, f.time);
+    let vh = Vec3::new(v.x, 0.0, v.z);
+    let u = vh.length();
+    if u < 1e-6 {
+        return Quat::IDENTITY;
+    }
+    let w = vh / u;
+    let dir = Vec3::from_array(stem.dir);
+    let pa = Vec3::from_array(stem.parent_axis);
+    let bh = Vec3::new(dir.x, 0.0, dir.z);
+    let c = if bh.length() > 1e-4 { bh.normalize().dot(w) } else { 0.0 };
+    let facing = (-c).max(0.0);
+    let back = c.max(0.0);
+    let perp = 1.0 - c.abs();
+    let theta = (stem.drag * u * u).min(f.max_bend) * f.amplitude;
+    let osc = value_noise(stem.freq * f.time + stem.phase, stem.seed);
+    let osc2 = value_noise(2.7 * stem.freq * f.time + stem.phase, stem.seed ^ 0x55);
+    let inertia = -f.inertia * f.trunk_rate / (std::f32::consts::TAU * stem.freq);
+    let bend = theta * (facing * (0.9 + 0.1 * osc) + back * (0.4 + 0.8 * osc) + perp * (0.6 + 0.3 * osc))
+        + inertia * f.amplitude;
+    let k = axis_or(dir.cross(w), axis_or(up.cross(w), Vec3::X));
+    let side = if pa.cross(dir).dot(w) >= 0.0 { 1.0 } else { -1.0 };
+    let swing = side * perp * theta * (0.5 + 0.5 * osc2);
+    let twist = perp * theta * 0.3 * osc2;
+    Quat::from_axis_angle(k, bend * frac)
+        * Quat::from_axis_angle(pa, swing * frac)
+        * Quat::from_axis_angle(dir, twist * frac)
+}
+
+/// The kernel's CPU twin.
+pub fn zioma_rotations(
+    fields: &[RawField],
+    waves: &[RawWave],
+    segments: &[RawSegment],
+    stems: &[RawZiomaStem],
+    frame: &RawZiomaFrame,
+    out: &mut [[f32; 4]],
+) {
+    out.par_iter_mut().zip(segments.par_iter()).for_each(|(o, s)| {
+        *o = zioma_rotation(fields, waves, s, &stems[s.stem as usize], frame).to_array();
+    });
+}

@@ -1,0 +1,139 @@
+//! GPU twin of the pose seam ([`sylva_core::animate`]): forward kinematics from per-segment
+//! rotations, and Zioma's method producing those rotations on the GPU.
+
+use crate::kernel::{Kernel, output, read_back, upload};
+use crate::shader::{NOISE, POSE_ACCUMULATE, POSE_POSITIONS, QUAT, TREE, WIND, ZIOMA_ROTATIONS};
+use crate::{GpuContext, GpuError};
+use glam::{Quat, Vec3};
+use std::sync::Arc;
+use sylva_core::Tree;
+use sylva_core::animate::Pose;
+use sylva_core::animate::zioma::{RawZiomaFrame, Zioma};
+use sylva_core::wind::WindScene;
+use sylva_core::wind::raw::{RawField, RawWave};
+
+/// A tree uploaded once; poses computed on the GPU from rotations made there.
+#[derive(Debug)]
+pub struct GpuPose {
+    accumulate: Arc<Kernel>,
+    positions: Arc<Kernel>,
+    parents: wgpu::Buffer,
+    rest: wgpu::Buffer,
+    delta: wgpu::Buffer,
+    acc: wgpu::Buffer,
+    joints: wgpu::Buffer,
+    n: usize,
+    rest_orientation: Vec<Quat>,
+}
+
+impl GpuPose {
+    /// Uploads the tree's hierarchy and rest joints.
+    pub fn new(ctx: &GpuContext, tree: &Tree) -> Result<Self, GpuError> {
+        let n = tree.segments.len();
+        let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
+        Ok(Self {
+            accumulate: Kernel::cached(ctx, "pose_accumulate", &[QUAT, TREE, POSE_ACCUMULATE]),
+            positions: Kernel::cached(ctx, "pose_positions", &[QUAT, TREE, POSE_POSITIONS]),
+            parents: upload(ctx, "parents", &tree.segments.parent)?,
+            rest: upload(ctx, "rest joints", &rest)?,
+            delta: output::<[f32; 4]>(ctx, "delta", n)?,
+            acc: output::<[f32; 4]>(ctx, "acc", n)?,
+            joints: output::<[f32; 4]>(ctx, "joints", n)?,
+            n,
+            rest_orientation: tree.segments.orientation.clone(),
+        })
+    }
+
+    /// The buffer a method writes its rotations δ into.
+    pub fn delta_buffer(&self) -> &wgpu::Buffer {
+        &self.delta
+    }
+
+    /// Runs forward kinematics on the rotations in [`Self::delta_buffer`] (recorded into
+    /// `encoder`).
+    pub fn record(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+        self.accumulate.record(ctx, encoder, &[&self.parents, &self.delta, &self.acc], self.n as u32);
+        self.positions.record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, &self.joints], self.n as u32);
+    }
+
+    /// Forward kinematics of given rotations, read back as a [`Pose`].
+    pub fn pose_from_rotations(&self, ctx: &GpuContext, delta: &[[f32; 4]]) -> Result<Pose, GpuError> {
+        ctx.queue.write_buffer(&self.delta, 0, bytemuck::cast_slice(delta));
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.record(ctx, &mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        self.read(ctx)
+    }
+
+    /// Reads the current pose back.
+    pub fn read(&self, ctx: &GpuContext) -> Result<Pose, GpuError> {
+        let joints: Vec<[f32; 4]> = read_back(ctx, &self.joints, self.n)?;
+        let acc: Vec<[f32; 4]> = read_back(ctx, &self.acc, self.n)?;
+        Ok(Pose {
+            start: joints.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect(),
+            orientation: acc.iter().zip(&self.rest_orientation).map(|(d, q)| Quat::from_array(*d) * *q).collect(),
+            bezier: None,
+        })
+    }
+}
+
+/// Zioma's method on the GPU: rotations from `zioma_rotations.wgsl`, pose from [`GpuPose`],
+/// all in one submission per frame.
+#[derive(Debug)]
+pub struct GpuZioma {
+    kernel: Arc<Kernel>,
+    pose: GpuPose,
+    fields: wgpu::Buffer,
+    waves: wgpu::Buffer,
+    segments: wgpu::Buffer,
+    stems: wgpu::Buffer,
+    frame: wgpu::Buffer,
+    packed: (Vec<RawField>, Vec<RawWave>),
+}
+
+impl GpuZioma {
+    /// Uploads the tree, Zioma's per-stem constants and the wind scene.
+    pub fn new(ctx: &GpuContext, tree: &Tree, method: &Zioma, wind: &WindScene) -> Result<Self, GpuError> {
+        let (fields, waves) = wind.pack();
+        let zero_field =
+            [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
+        let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
+        Ok(Self {
+            kernel: Kernel::cached(ctx, "zioma_rotations", &[QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS]),
+            pose: GpuPose::new(ctx, tree)?,
+            fields: upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { &fields })?,
+            waves: upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { &waves })?,
+            segments: upload(ctx, "segments", &tree.raw_segments())?,
+            stems: upload(ctx, "zioma stems", &method.stems)?,
+            frame: upload(ctx, "zioma frame", &[RawZiomaFrame::default_zeroed()])?,
+            packed: (fields, waves),
+        })
+    }
+
+    /// The pose at time `t`: the per-tree frame values are computed on the CPU (one wind
+    /// sample and the trunk bands), everything per segment on the GPU.
+    pub fn pose(&self, ctx: &GpuContext, tree: &Tree, method: &Zioma, t: f32) -> Result<Pose, GpuError> {
+        let frame = method.frame(tree, &self.packed.0, &self.packed.1, t);
+        ctx.queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame));
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.kernel.record(
+            ctx,
+            &mut encoder,
+            &[&self.fields, &self.waves, &self.segments, &self.stems, &self.frame, self.pose.delta_buffer()],
+            self.pose.n as u32,
+        );
+        self.pose.record(ctx, &mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        self.pose.read(ctx)
+    }
+}
+
+trait Zeroed {
+    fn default_zeroed() -> Self;
+}
+
+impl Zeroed for RawZiomaFrame {
+    fn default_zeroed() -> Self {
+        bytemuck::Zeroable::zeroed()
+    }
+}

@@ -1,0 +1,102 @@
+// zioma_rotations: Zioma's per-segment rotations. CPU twin:
+// sylva_core::cpu::zioma_rotations (bindings 0 fields, 1 waves — from wind.wgsl —
+// 2 segments, 3 stems, 4 frame, 5 delta).
+
+struct ZiomaStem {
+    base: vec3<f32>,
+    drag: f32,
+    dir: vec3<f32>,
+    freq: f32,
+    parent_axis: vec3<f32>,
+    phase: f32,
+    level: u32,
+    seed: u32,
+    length: f32,
+    _pad: u32,
+}
+
+struct ZiomaFrame {
+    wind_dir: vec3<f32>,
+    time: f32,
+    trunk: vec3<f32>,
+    trunk_rate: f32,
+    lod: u32,
+    amplitude: f32,
+    max_bend: f32,
+    inertia: f32,
+}
+
+@group(0) @binding(2) var<storage, read> segments: array<Segment>;
+@group(0) @binding(3) var<storage, read> stems: array<ZiomaStem>;
+@group(0) @binding(4) var<storage, read> frame: ZiomaFrame;
+@group(0) @binding(5) var<storage, read_write> delta: array<vec4<f32>>;
+
+fn axis_or(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
+    let l = length(v);
+    if (l > 1e-6) {
+        return v / l;
+    }
+    return fallback;
+}
+
+const IDENTITY: vec4<f32> = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+
+fn zioma_rotation(s: Segment, stem: ZiomaStem, f: ZiomaFrame) -> vec4<f32> {
+    let frac = s.length / stem.length;
+    let up = vec3<f32>(0.0, 1.0, 0.0);
+    if (s.level == 0u) {
+        let w = f.wind_dir;
+        let par_axis = axis_or(cross(up, w), vec3<f32>(1.0, 0.0, 0.0));
+        let perp_axis = axis_or(w, vec3<f32>(0.0, 0.0, 1.0));
+        return quat_mul(
+            quat_mul(quat_axis_angle(par_axis, f.trunk.x * frac), quat_axis_angle(perp_axis, f.trunk.y * frac)),
+            quat_axis_angle(up, f.trunk.z * frac),
+        );
+    }
+    if (f.lod == 0u) {
+        return IDENTITY;
+    }
+    let v = wind_at(stem.base, f.time);
+    let vh = vec3<f32>(v.x, 0.0, v.z);
+    let u = length(vh);
+    if (u < 1e-6) {
+        return IDENTITY;
+    }
+    let w = vh / u;
+    let dir = stem.dir;
+    let pa = stem.parent_axis;
+    let bh = vec3<f32>(dir.x, 0.0, dir.z);
+    var c = 0.0;
+    if (length(bh) > 1e-4) {
+        c = dot(normalize(bh), w);
+    }
+    let facing = max(-c, 0.0);
+    let back = max(c, 0.0);
+    let perp = 1.0 - abs(c);
+    let theta = min(stem.drag * u * u, f.max_bend) * f.amplitude;
+    let osc = value_noise(stem.freq * f.time + stem.phase, stem.seed);
+    let osc2 = value_noise(2.7 * stem.freq * f.time + stem.phase, stem.seed ^ 0x55u);
+    let inertia = -f.inertia * f.trunk_rate / (TAU * stem.freq);
+    let bend = theta * (facing * (0.9 + 0.1 * osc) + back * (0.4 + 0.8 * osc) + perp * (0.6 + 0.3 * osc)) + inertia * f.amplitude;
+    let k = axis_or(cross(dir, w), axis_or(cross(up, w), vec3<f32>(1.0, 0.0, 0.0)));
+    var side = -1.0;
+    if (dot(cross(pa, dir), w) >= 0.0) {
+        side = 1.0;
+    }
+    let swing = side * perp * theta * (0.5 + 0.5 * osc2);
+    let twist = perp * theta * 0.3 * osc2;
+    return quat_mul(
+        quat_mul(quat_axis_angle(k, bend * frac), quat_axis_angle(pa, swing * frac)),
+        quat_axis_angle(dir, twist * frac),
+    );
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * 64u;
+    if (i >= arrayLength(&segments)) {
+        return;
+    }
+    let s = segments[i];
+    delta[i] = zioma_rotation(s, stems[s.stem], frame);
+}
