@@ -3,6 +3,7 @@
 //! With no arguments, runs the main job on the built-in default scene. Until the renderer
 //! lands that is `sylva generate` on the default species.
 
+mod simulate_cmd;
 mod wind_cmd;
 
 use anyhow::{Context, Result};
@@ -29,6 +30,8 @@ enum Command {
     Presets,
     /// Plot a wind scene: speed at a point over time, and a top-down map of the field.
     Wind(wind_cmd::WindArgs),
+    /// Animate a tree in the wind and report how it moved (optionally a CSV trajectory).
+    Simulate(simulate_cmd::SimulateArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -71,6 +74,7 @@ fn main() -> Result<()> {
             presets();
             Ok(())
         }
+        Some(Command::Simulate(args)) => simulate_cmd::run(&args),
         Some(Command::Wind(args)) => {
             for p in wind_cmd::run(&args)? {
                 println!("wrote {}", p.display());

@@ -132,3 +132,59 @@ fn wind_on_the_gpu_draws_the_same_field() {
         std::fs::read(dir.path().join("c/wind_field.png")).unwrap()
     );
 }
+
+#[test]
+fn simulate_reports_motion_and_writes_a_trajectory() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = sylva(
+        dir.path(),
+        &[
+            "simulate",
+            "--species",
+            "lombardy_poplar",
+            "--seconds",
+            "2",
+            "--fps",
+            "30",
+            "--csv",
+            "t.csv",
+            "--track",
+            "0,5",
+        ],
+    );
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("61 frames") && out.contains("mean tip disp") && out.contains("largest segment-end speed"),
+        "{out}"
+    );
+    let csv = std::fs::read_to_string(dir.path().join("t.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines[0], "time_s,segment,level,x,y,z,dx,dy,dz");
+    assert_eq!(lines.len(), 1 + 2 * 61);
+    // The trunk's root segment turns about its base: its end moves downwind (+x in `gusty`).
+    let last: Vec<f32> = lines[lines.len() - 2].split(',').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(last[1], 0.0);
+    assert!(last[6] > 0.0, "{:?}", last);
+    // Still air: nothing moves.
+    std::fs::write(dir.path().join("calm.toml"), "").unwrap();
+    let (ok, out, err) = sylva(dir.path(), &["simulate", "--wind", "calm.toml", "--seconds", "1", "--fps", "10"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("largest segment-end speed 0.000 m/s"), "{out}");
+}
+
+#[test]
+fn simulate_rejects_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, needle) in [
+        (vec!["simulate", "--seconds=-1"], "--seconds"),
+        (vec!["simulate", "--fps", "0"], "--fps"),
+        (vec!["simulate", "--seconds", "1e9", "--fps", "1000"], "limit"),
+        (vec!["simulate", "--track", "999999"], "--track"),
+        (vec!["simulate", "--method", "magic"], "magic"),
+        (vec!["simulate", "--wind", "nowhere.toml"], "nowhere.toml"),
+    ] {
+        let (ok, _, err) = sylva(dir.path(), &args);
+        assert!(!ok, "{args:?} succeeded");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}
