@@ -19,6 +19,7 @@
 //! A [`Pose`] is what meshers, renderers and exporters consume: per-segment world joint
 //! position and orientation, plus animated Bézier control points for methods that have them.
 
+pub mod akagi;
 pub mod zioma;
 
 use crate::model::Tree;

@@ -1,6 +1,7 @@
 //! CPU references of the GPU kernels, with the same names, binding order and loop shape as
 //! their WGSL twins in `sylva-gpu/src/shader/` (`cpu::x` ↔ `shader/x.wgsl`).
 
+pub mod akagi;
 pub mod noise;
 pub mod pose_fk;
 mod segment_ends;
