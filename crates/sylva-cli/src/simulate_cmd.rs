@@ -6,6 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
+use sylva_core::animate::akagi::{Akagi, AkagiParams};
 use sylva_core::animate::zioma::{Lod, Zioma, ZiomaParams};
 use sylva_core::animate::{Pose, displacement};
 use sylva_core::species::{DEFAULT_SPECIES, SpeciesSource};
@@ -17,6 +18,8 @@ use sylva_core::{Limits, Tree};
 pub enum Method {
     /// Zioma (GPU Gems 3 ch. 6): procedural, stateless.
     Zioma,
+    /// Akagi & Kitajima §2.5: wind forces propagated to the root, damped angular springs.
+    Akagi,
 }
 
 /// Where to run.
@@ -97,22 +100,57 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     if let Some(&bad) = track.iter().find(|&&i| i >= n) {
         bail!("--track {bad}: the tree has {n} segments (0..{})", n - 1);
     }
-    let params =
-        ZiomaParams { lod: if a.trunk_only { Lod::TrunkOnly } else { Lod::Full }, seed: a.seed, ..Default::default() };
-    let method = Zioma::new(&tree, params);
-    let gpu = match a.backend {
+    if a.trunk_only && a.method != Method::Zioma {
+        bail!("--trunk-only is Zioma's simulation LOD; {:?} has none", a.method);
+    }
+    let ctx = match a.backend {
         Backend::Cpu => None,
         Backend::Gpu => {
             let ctx = sylva_gpu::GpuContext::shared()?;
             println!("GPU: {}", ctx.summary);
-            Some((ctx, sylva_gpu::pose::GpuZioma::new(ctx, &tree, &method, &wind)?))
+            Some(ctx)
         }
     };
-    let pose_at = |t: f32| -> Result<Pose> {
-        Ok(match &gpu {
-            None => method.pose(&tree, &wind, t),
-            Some((ctx, g)) => g.pose(ctx, &tree, &method, t)?,
-        })
+    let (fields, waves) = wind.pack();
+    let (tree_ref, wind_ref) = (&tree, &wind);
+    // One closure per method and backend: (time, step since the last frame) → pose.
+    type Runner<'a> = Box<dyn FnMut(f32, f32) -> Result<Pose> + 'a>;
+    let mut runner: Runner<'_> = match (a.method, ctx) {
+        (Method::Zioma, ctx) => {
+            let params = ZiomaParams {
+                lod: if a.trunk_only { Lod::TrunkOnly } else { Lod::Full },
+                seed: a.seed,
+                ..Default::default()
+            };
+            let method = Zioma::new(tree_ref, params);
+            match ctx {
+                None => Box::new(move |t, _| Ok(method.pose(tree_ref, wind_ref, t))),
+                Some(ctx) => {
+                    let g = sylva_gpu::pose::GpuZioma::new(ctx, tree_ref, &method, wind_ref)?;
+                    Box::new(move |t, _| Ok(g.pose(ctx, tree_ref, &method, t)?))
+                }
+            }
+        }
+        (Method::Akagi, None) => {
+            let method = Akagi::new(tree_ref, AkagiParams::default());
+            let mut state = method.rest_state(tree_ref);
+            Box::new(move |_, dt| {
+                if dt > 0.0 {
+                    method.step(tree_ref, &fields, &waves, &mut state, dt);
+                }
+                Ok(state.pose.clone())
+            })
+        }
+        (Method::Akagi, Some(ctx)) => {
+            let method = Akagi::new(tree_ref, AkagiParams::default());
+            let mut g = sylva_gpu::pose::GpuAkagi::new(ctx, tree_ref, &method, wind_ref)?;
+            Box::new(move |_, dt| {
+                if dt > 0.0 {
+                    g.step(ctx, dt);
+                }
+                Ok(g.read(ctx)?)
+            })
+        }
     };
 
     let mut guard = TempFile(None);
@@ -140,7 +178,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let dt = 1.0 / a.fps;
     for f in 0..frames {
         let t = f as f32 * dt;
-        let pose = pose_at(t)?;
+        let pose = runner(t, if f == 0 { 0.0 } else { dt })?;
         let d = displacement(&tree, &pose);
         for l in 0..levels {
             sum_mean[l] += d.mean[l] as f64;

@@ -173,6 +173,19 @@ fn simulate_reports_motion_and_writes_a_trajectory() {
 }
 
 #[test]
+fn simulate_runs_akagi_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = sylva(
+        dir.path(),
+        &["simulate", "--method", "akagi", "--species", "monopodial", "--seconds", "1", "--fps", "30"],
+    );
+    assert!(ok, "{err}");
+    assert!(out.contains("Akagi on Cpu") && out.contains("31 frames"), "{out}");
+    let (ok, _, err) = sylva(dir.path(), &["simulate", "--method", "akagi", "--trunk-only"]);
+    assert!(!ok && err.contains("--trunk-only"), "{err}");
+}
+
+#[test]
 fn simulate_rejects_bad_input() {
     let dir = tempfile::tempdir().unwrap();
     for (args, needle) in [

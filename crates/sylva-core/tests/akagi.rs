@@ -55,7 +55,10 @@ fn constant_wind_bends_downwind_more_as_it_rises() {
 /// ω_d = √(k/I) · √(1 − ζ²), I = m L²/3 about its base.
 #[test]
 fn a_single_cantilever_rings_at_the_spring_frequency() {
-    let t = Grammar::parse("width-scale: 0.02\naxiom: !(1)F(1)\n", "one.lsys").unwrap().generate(&LSystemOptions::default()).unwrap();
+    let t = Grammar::parse("width-scale: 0.02\naxiom: !(1)F(1)\n", "one.lsys")
+        .unwrap()
+        .generate(&LSystemOptions::default())
+        .unwrap();
     let params = AkagiParams { damping_ratio: 0.05, ..Default::default() };
     let a = Akagi::new(&t, params);
     let s0 = &t.segments;

@@ -137,3 +137,136 @@ impl Zeroed for RawZiomaFrame {
         bytemuck::Zeroable::zeroed()
     }
 }
+
+/// Akagi's method on the GPU: forces, one propagation dispatch per depth (deepest first),
+/// springs and the pose seam, all in one submission per step; the state stays on the GPU.
+#[derive(Debug)]
+pub struct GpuAkagi {
+    forces: Arc<Kernel>,
+    subtree: Arc<Kernel>,
+    integrate: Arc<Kernel>,
+    pose: GpuPose,
+    fields: wgpu::Buffer,
+    waves: wgpu::Buffer,
+    segments: wgpu::Buffer,
+    akagi: wgpu::Buffer,
+    step: wgpu::Buffer,
+    method_step: sylva_core::animate::akagi::RawAkagiStep,
+    buckets: Vec<(wgpu::Buffer, u32)>,
+    child_offset: wgpu::Buffer,
+    child_count: wgpu::Buffer,
+    child_index: wgpu::Buffer,
+    f_own: wgpu::Buffer,
+    f_sub: wgpu::Buffer,
+    theta: wgpu::Buffer,
+    omega: wgpu::Buffer,
+    /// Simulated time, s.
+    pub time: f32,
+}
+
+impl GpuAkagi {
+    /// Uploads the tree, Akagi's constants and the wind; the state starts at rest.
+    pub fn new(
+        ctx: &GpuContext,
+        tree: &Tree,
+        method: &sylva_core::animate::akagi::Akagi,
+        wind: &WindScene,
+    ) -> Result<Self, GpuError> {
+        use crate::shader::{AKAGI, AKAGI_FORCES, AKAGI_INTEGRATE, AKAGI_SUBTREE};
+        let (fields, waves) = wind.pack();
+        let zero_field =
+            [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
+        let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
+        let n = tree.segments.len();
+        let pose = GpuPose::new(ctx, tree)?;
+        // The pose seam's accumulated rotations start at the identity.
+        ctx.queue.write_buffer(&pose.acc, 0, bytemuck::cast_slice(&vec![[0.0f32, 0.0, 0.0, 1.0]; n]));
+        let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
+        ctx.queue.write_buffer(&pose.joints, 0, bytemuck::cast_slice(&rest));
+        let c = &tree.children;
+        let index = if c.index.is_empty() { vec![0u32] } else { c.index.clone() };
+        Ok(Self {
+            forces: Kernel::cached(ctx, "akagi_forces", &[QUAT, TREE, NOISE, WIND, AKAGI, AKAGI_FORCES]),
+            subtree: Kernel::cached(ctx, "akagi_subtree", &[AKAGI_SUBTREE]),
+            integrate: Kernel::cached(ctx, "akagi_integrate", &[QUAT, TREE, AKAGI, AKAGI_INTEGRATE]),
+            pose,
+            fields: upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { &fields })?,
+            waves: upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { &waves })?,
+            segments: upload(ctx, "segments", &tree.raw_segments())?,
+            akagi: upload(ctx, "akagi segments", &method.segments)?,
+            step: upload(ctx, "akagi step", &[method.step_params(0.0, 0.0)])?,
+            method_step: method.step_params(0.0, 0.0),
+            buckets: method
+                .buckets
+                .iter()
+                .map(|b| {
+                    let mut padded = b.clone();
+                    padded.resize(b.len().div_ceil(4) * 4, u32::MAX);
+                    Ok((upload(ctx, "akagi bucket", &padded)?, b.len() as u32))
+                })
+                .collect::<Result<_, GpuError>>()?,
+            child_offset: upload(ctx, "child offsets", &c.offset)?,
+            child_count: upload(ctx, "child counts", &c.count)?,
+            child_index: upload(ctx, "child indices", &index)?,
+            f_own: output::<[f32; 4]>(ctx, "own forces", n)?,
+            f_sub: output::<[f32; 4]>(ctx, "subtree forces", n)?,
+            theta: output::<[f32; 4]>(ctx, "theta", n)?,
+            omega: output::<[f32; 4]>(ctx, "omega", n)?,
+            time: 0.0,
+        })
+    }
+
+    /// Advances by `dt` seconds (one step; submitted, not waited for).
+    pub fn step(&mut self, ctx: &GpuContext, dt: f32) {
+        self.time += dt;
+        let step = sylva_core::animate::akagi::RawAkagiStep { time: self.time, dt, ..self.method_step };
+        ctx.queue.write_buffer(&self.step, 0, bytemuck::bytes_of(&step));
+        let n = self.pose.n as u32;
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        self.forces.record(
+            ctx,
+            &mut e,
+            &[
+                &self.fields,
+                &self.waves,
+                &self.segments,
+                &self.akagi,
+                &self.pose.joints,
+                &self.pose.acc,
+                &self.step,
+                &self.f_own,
+            ],
+            n,
+        );
+        for (bucket, len) in &self.buckets {
+            self.subtree.record(
+                ctx,
+                &mut e,
+                &[bucket, &self.child_offset, &self.child_count, &self.child_index, &self.f_own, &self.f_sub],
+                *len,
+            );
+        }
+        self.integrate.record(
+            ctx,
+            &mut e,
+            &[
+                &self.segments,
+                &self.akagi,
+                &self.f_sub,
+                &self.pose.acc,
+                &self.step,
+                &self.theta,
+                &self.omega,
+                &self.pose.delta,
+            ],
+            n,
+        );
+        self.pose.record(ctx, &mut e);
+        ctx.queue.submit([e.finish()]);
+    }
+
+    /// Reads the current pose back (waits for the GPU).
+    pub fn read(&self, ctx: &GpuContext) -> Result<Pose, GpuError> {
+        self.pose.read(ctx)
+    }
+}

@@ -9,10 +9,15 @@
 //!    deepest first (the GPU runs one dispatch per depth).
 //! 3. **Rotation** (`akagi_integrate`): the component of that force perpendicular to the
 //!    segment, at its tip, gives the torque `τ = L (â × F)`; the segment turns about its
-//!    base against the rotational stiffness `k = E·I/L` as a damped angular spring,
+//!    base against the rotational stiffness `k = E·I/L` (with the mechanical radius: the
+//!    model's, but never thinner than its children together, Leonardo's rule, nor than
+//!    `min_radius`) as a damped angular spring,
 //!    `I θ̈ = τ − k θ − c θ̇`, with `I` the subtree's moment of inertia about the joint and
 //!    `c = 2 ζ √(k I)`. Integration is implicit in the spring and damping terms, so it is
 //!    stable for any step. θ is a rotation vector in the parent's rest frame.
+//!    Two additions keep strong wind physical: drag grows as `U^1.3` above
+//!    `reconfiguration_speed` (leaves streamline, Vogel 1989), and the spring stiffens as
+//!    `k (1 + (|θ|/θ_s)²)` so joints do not spin through large angles.
 //! 4. **Pose**: rotations `δ = exp(θ)` applied root to tip through the seam.
 
 use super::Pose;
@@ -29,15 +34,40 @@ pub struct AkagiParams {
     /// Damping ratio ζ of every joint. Default 0.15: measured damping ratios of tree sway
     /// are 0.05–0.3 (aerodynamic and internal damping together).
     pub damping_ratio: f32,
-    /// Drag coefficient of bark and leaves (a cylinder in cross-flow ≈ 1.0–1.2).
+    /// Drag coefficient of bark (a cylinder in cross-flow ≈ 1.0–1.2).
     pub drag: f32,
+    /// Effective drag coefficient per unit (one-sided) leaf area. Default 0.05: leaves in a
+    /// crown shelter one another, so the sum over leaves must come to a crown's drag
+    /// (C_d ≈ 0.3 on the crown's frontal area, which for a broadleaf crown is 5–10 times
+    /// smaller than its leaf area).
+    pub leaf_drag: f32,
     /// Substeps per `step` call.
     pub substeps: u32,
+    /// Thinnest radius used for a joint's stiffness, m. Default 1.5 mm: generators taper
+    /// twigs toward zero for looks, but living twig tips are 2–5 mm thick; without a floor
+    /// the stiffness `E·π r⁴/4L` of a tip vanishes and it spins in the wind.
+    pub min_radius: f32,
+    /// Speed above which bark and leaves streamline, m/s: drag grows as `U^(2 − 0.7)`
+    /// beyond it instead of `U²` (Vogel 1989: leaves and crowns reconfigure in strong wind,
+    /// with Vogel exponents around −0.7).
+    pub reconfiguration_speed: f32,
+    /// Angle at which a joint has stiffened to twice its small-angle stiffness, rad: the
+    /// spring is `k (1 + (|θ|/θ_s)²)` — wood stiffens and branches stop rotating as rigid
+    /// segments well before they turn by a radian.
+    pub stiffening_angle: f32,
 }
 
 impl Default for AkagiParams {
     fn default() -> Self {
-        Self { damping_ratio: 0.15, drag: 0.8, substeps: 1 }
+        Self {
+            damping_ratio: 0.15,
+            drag: 0.8,
+            leaf_drag: 0.05,
+            substeps: 1,
+            min_radius: 0.0015,
+            reconfiguration_speed: 5.0,
+            stiffening_angle: 0.5,
+        }
     }
 }
 
@@ -47,7 +77,8 @@ impl Default for AkagiParams {
 pub struct RawAkagiSegment {
     /// Bark area facing a cross-flow, 2 r̄ L, m².
     pub bark_area: f32,
-    /// Leaf area on the segment, m².
+    /// Leaf area on the segment scaled by `leaf_drag / drag`, so one coefficient serves
+    /// both: m².
     pub leaf_area: f32,
     /// Moment of inertia of the subtree about the joint, kg·m².
     pub inertia: f32,
@@ -57,6 +88,24 @@ pub struct RawAkagiSegment {
     pub damping: f32,
     /// Padding.
     pub _pad: [u32; 3],
+}
+
+/// Per-step values, 32 bytes. WGSL: `AkagiStep` in `akagi.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawAkagiStep {
+    /// Drag coefficient.
+    pub drag: f32,
+    /// Time at the end of the step, s.
+    pub time: f32,
+    /// Step, s.
+    pub dt: f32,
+    /// See [`AkagiParams::reconfiguration_speed`].
+    pub reconfiguration_speed: f32,
+    /// See [`AkagiParams::stiffening_angle`].
+    pub stiffening_angle: f32,
+    /// Padding.
+    pub _pad: [f32; 3],
 }
 
 /// Simulation state: structure of arrays in topological order.
@@ -83,6 +132,8 @@ pub struct Akagi {
     pub segments: Vec<RawAkagiSegment>,
     /// Segment indices grouped by depth in the hierarchy, deepest first.
     pub buckets: Vec<Vec<u32>>,
+    raw: Vec<crate::model::RawSegment>,
+    rest: Vec<[f32; 4]>,
 }
 
 impl Akagi {
@@ -112,12 +163,20 @@ impl Akagi {
             mass[i] = m_sub;
             inertia[i] = inert.max(1e-12);
         }
+        // Mechanical radius: at least `min_radius`, and by Leonardo's rule at least the
+        // radius whose cross-section equals its children's together (a joint carries what
+        // grows beyond it). Generators taper radii for looks; the mechanics need this.
+        let mut r_mech = vec![0.0f32; n];
+        for i in (0..n).rev() {
+            let carried: f32 = tree.children.of(i).iter().map(|&c| r_mech[c as usize].powi(2)).sum();
+            r_mech[i] = s.radius_base[i].max(params.min_radius).max(carried.sqrt());
+        }
         let segments = (0..n)
             .map(|i| {
-                let k = s.stiffness[i];
+                let k = tree.wood.segment_stiffness(s.length[i], r_mech[i]);
                 RawAkagiSegment {
                     bark_area: (s.radius_base[i] + s.radius_tip[i]) * s.length[i],
-                    leaf_area: leaf_area[i],
+                    leaf_area: leaf_area[i] * params.leaf_drag / params.drag.max(1e-6),
                     inertia: inertia[i],
                     stiffness: k,
                     damping: 2.0 * params.damping_ratio * (k * inertia[i]).sqrt(),
@@ -136,7 +195,8 @@ impl Akagi {
         for (i, d) in depth.iter().enumerate() {
             buckets[max - d].push(i as u32);
         }
-        Self { params, segments, buckets }
+        let rest = s.start.iter().map(|p| p.extend(0.0).to_array()).collect();
+        Self { params, segments, buckets, raw: tree.raw_segments(), rest }
     }
 
     /// The state at rest.
@@ -151,6 +211,18 @@ impl Akagi {
         }
     }
 
+    /// The per-step values the kernels read.
+    pub fn step_params(&self, time: f32, dt: f32) -> RawAkagiStep {
+        RawAkagiStep {
+            drag: self.params.drag,
+            time,
+            dt,
+            reconfiguration_speed: self.params.reconfiguration_speed,
+            stiffening_angle: self.params.stiffening_angle,
+            _pad: [0.0; 3],
+        }
+    }
+
     /// Natural angular frequency √(k/I) of segment `i`'s joint, rad/s.
     pub fn natural_frequency(&self, i: usize) -> f32 {
         (self.segments[i].stiffness / self.segments[i].inertia).sqrt()
@@ -159,25 +231,42 @@ impl Akagi {
     /// Advances `state` by `dt` seconds (in `params.substeps` substeps) in `wind`.
     pub fn step(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], state: &mut AkagiState, dt: f32) {
         let n = tree.segments.len();
-        let raw = tree.raw_segments();
         let sub = dt / self.params.substeps.max(1) as f32;
         let mut f_own = vec![[0.0f32; 4]; n];
         let mut f_sub = vec![[0.0f32; 4]; n];
         let mut delta = vec![[0.0f32; 4]; n];
-        let joints: Vec<[f32; 4]> = state.pose.start.iter().map(|p| p.extend(0.0).to_array()).collect();
-        let mut joints = joints;
+        let mut joints: Vec<[f32; 4]> = state.pose.start.iter().map(|p| p.extend(0.0).to_array()).collect();
         for _ in 0..self.params.substeps.max(1) {
             let t = state.time + sub;
-            akagi_forces(fields, waves, &raw, &self.segments, &joints, &state.acc, self.params.drag, t, &mut f_own);
+            let step = self.step_params(t, sub);
+            akagi_forces(fields, waves, &self.raw, &self.segments, &joints, &state.acc, step, &mut f_own);
             for bucket in &self.buckets {
-                akagi_subtree(bucket, &tree.children.offset, &tree.children.count, &tree.children.index, &f_own, &mut f_sub);
+                akagi_subtree(
+                    bucket,
+                    &tree.children.offset,
+                    &tree.children.count,
+                    &tree.children.index,
+                    &f_own,
+                    &mut f_sub,
+                );
             }
-            akagi_integrate(&raw, &self.segments, &f_sub, &state.acc, sub, &mut state.theta, &mut state.omega, &mut delta);
-            let pose = Pose::from_rotations(tree, &delta);
+            akagi_integrate(
+                &self.raw,
+                &self.segments,
+                &f_sub,
+                &state.acc,
+                step,
+                &mut state.theta,
+                &mut state.omega,
+                &mut delta,
+            );
             crate::cpu::pose_fk::pose_accumulate(&tree.segments.parent, &delta, &mut state.acc);
-            joints = pose.start.iter().map(|p| p.extend(0.0).to_array()).collect();
-            state.pose = pose;
+            crate::cpu::pose_fk::pose_positions(&tree.segments.parent, &self.rest, &state.acc, &mut joints);
             state.time = t;
+        }
+        for (i, j) in joints.iter().enumerate() {
+            state.pose.start[i] = Vec3::new(j[0], j[1], j[2]);
+            state.pose.orientation[i] = glam::Quat::from_array(state.acc[i]) * tree.segments.orientation[i];
         }
     }
 

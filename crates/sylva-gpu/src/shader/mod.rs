@@ -19,6 +19,14 @@ pub const POSE_ACCUMULATE: &str = include_str!("pose_accumulate.wgsl");
 pub const POSE_POSITIONS: &str = include_str!("pose_positions.wgsl");
 /// Kernel: Zioma's per-segment rotations.
 pub const ZIOMA_ROTATIONS: &str = include_str!("zioma_rotations.wgsl");
+/// Akagi's shared structs (`AkagiSegment`, `AkagiStep`).
+pub const AKAGI: &str = include_str!("akagi.wgsl");
+/// Kernel: Akagi's own wind force per segment.
+pub const AKAGI_FORCES: &str = include_str!("akagi_forces.wgsl");
+/// Kernel: one depth of Akagi's force propagation.
+pub const AKAGI_SUBTREE: &str = include_str!("akagi_subtree.wgsl");
+/// Kernel: Akagi's damped angular springs.
+pub const AKAGI_INTEGRATE: &str = include_str!("akagi_integrate.wgsl");
 /// Kernel: trunk noise bands at many (t, tree) samples.
 pub const TRUNK_NOISE: &str = include_str!("trunk_noise.wgsl");
 
@@ -30,6 +38,9 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("pose_accumulate", &[QUAT, TREE, POSE_ACCUMULATE]),
     ("pose_positions", &[QUAT, TREE, POSE_POSITIONS]),
     ("zioma_rotations", &[QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS]),
+    ("akagi_forces", &[QUAT, TREE, NOISE, WIND, AKAGI, AKAGI_FORCES]),
+    ("akagi_subtree", &[AKAGI_SUBTREE]),
+    ("akagi_integrate", &[QUAT, TREE, AKAGI, AKAGI_INTEGRATE]),
 ];
 
 /// Concatenates WGSL sources into one module.

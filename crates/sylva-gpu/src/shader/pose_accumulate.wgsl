@@ -9,7 +9,7 @@
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
-    if (i >= arrayLength(&parents)) {
+    if (i >= arrayLength(&delta)) {
         return;
     }
     var d = delta[i];

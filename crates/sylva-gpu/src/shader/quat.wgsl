@@ -21,3 +21,17 @@ fn quat_axis_angle(axis: vec3<f32>, angle: f32) -> vec4<f32> {
     let h = angle * 0.5;
     return vec4<f32>(axis * sin(h), cos(h));
 }
+
+// Inverse of a unit quaternion (its conjugate).
+fn quat_conj(q: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(-q.xyz, q.w);
+}
+
+// Rotation of |t| radians about t / |t|; exactly the identity at t = 0.
+fn quat_from_rotation_vector(t: vec3<f32>) -> vec4<f32> {
+    let a = length(t);
+    if (a == 0.0) {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    return quat_axis_angle(t / a, a);
+}

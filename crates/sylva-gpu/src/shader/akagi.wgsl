@@ -1,0 +1,22 @@
+// Shared by Akagi's kernels: per-segment constants and per-step parameters.
+// Twins: sylva_core::animate::akagi::RawAkagiSegment and the (drag, time, dt) arguments.
+
+struct AkagiSegment {
+    bark_area: f32,
+    leaf_area: f32,
+    inertia: f32,
+    stiffness: f32,
+    damping: f32,
+    _pad: array<u32, 3>,
+}
+
+struct AkagiStep {
+    drag: f32,
+    time: f32,
+    dt: f32,
+    reconfiguration_speed: f32,
+    stiffening_angle: f32,
+    _pad: array<f32, 3>,
+}
+
+const AIR_DENSITY: f32 = 1.225;
