@@ -132,9 +132,9 @@ fn trunk_only_lod_moves_branches_rigidly() {
     let wind = constant(15.0, [1.0, 0.0, 0.0]);
     let z = Zioma::new(&t, ZiomaParams { lod: Lod::TrunkOnly, ..Default::default() });
     let d = z.rotations(&t, &wind, 4.0);
-    for i in 0..t.segments.len() {
-        if t.segments.level[i] > 0 {
-            assert_eq!(d[i], [0.0, 0.0, 0.0, 1.0]);
+    for (di, level) in d.iter().zip(&t.segments.level) {
+        if *level > 0 {
+            assert_eq!(*di, [0.0, 0.0, 0.0, 1.0]);
         }
     }
     let full = Zioma::new(&t, ZiomaParams::default()).rotations(&t, &wind, 4.0);
