@@ -1,0 +1,91 @@
+//! Animation methods, CPU vs GPU in one run: Zioma (pose per frame) and Akagi (step per
+//! frame) on presets of increasing size. Reports segments per second and the GPU/CPU
+//! ratio. GPU figures are wall clock with synchronisation (a frame is several dispatches);
+//! the Akagi GPU step is measured over 60 steps followed by one readback.
+//!
+//! Run: `WGPU_BACKEND=vulkan cargo bench -p sylva-gpu --bench animate`.
+
+use std::time::{Duration, Instant};
+use sylva_core::animate::akagi::{Akagi, AkagiParams};
+use sylva_core::animate::zioma::{Zioma, ZiomaParams};
+use sylva_core::species::SpeciesSource;
+use sylva_core::wind::WindScene;
+use sylva_gpu::GpuContext;
+use sylva_gpu::pose::{GpuAkagi, GpuZioma};
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+fn time(reps: usize, mut f: impl FnMut()) -> Duration {
+    f();
+    median(
+        (0..reps)
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                t.elapsed()
+            })
+            .collect(),
+    )
+}
+
+fn main() {
+    let wind = WindScene::resolve("gusty").unwrap();
+    let (fields, waves) = wind.pack();
+    let ctx = GpuContext::shared().ok();
+    if let Some(c) = ctx {
+        println!("GPU: {}", c.summary);
+    }
+    println!("CPU threads: {}", rayon::current_num_threads());
+    println!(
+        "{:<16} {:>9} {:<6} {:>12} {:>12} {:>10}",
+        "tree", "segments", "method", "cpu Mseg/s", "gpu Mseg/s", "gpu/cpu"
+    );
+    for name in ["quaking_aspen", "black_tupelo", "weeping_willow"] {
+        let t = SpeciesSource::resolve(name).unwrap().generate(1, &Default::default(), None).unwrap();
+        let n = t.segments.len() as f64;
+        let rate = |d: Duration, frames: f64| n * frames / d.as_secs_f64() / 1e6;
+        // Zioma: one pose per frame.
+        let z = Zioma::new(&t, ZiomaParams::default());
+        let mut tt = 0.0;
+        let cpu = time(9, || {
+            tt += 1.0 / 60.0;
+            std::hint::black_box(z.pose(&t, &wind, tt));
+        });
+        let gpu = ctx.map(|c| {
+            let g = GpuZioma::new(c, &t, &z, &wind).unwrap();
+            time(9, || {
+                tt += 1.0 / 60.0;
+                std::hint::black_box(g.pose(c, &t, &z, tt).unwrap());
+            })
+        });
+        row(name, n, "zioma", rate(cpu, 1.0), gpu.map(|g| rate(g, 1.0)));
+        // Akagi: 60 steps.
+        let a = Akagi::new(&t, AkagiParams::default());
+        let mut s = a.rest_state(&t);
+        let cpu = time(3, || {
+            for _ in 0..60 {
+                a.step(&t, &fields, &waves, &mut s, 1.0 / 60.0);
+            }
+        });
+        let gpu = ctx.map(|c| {
+            let mut g = GpuAkagi::new(c, &t, &a, &wind).unwrap();
+            time(3, || {
+                for _ in 0..60 {
+                    g.step(c, 1.0 / 60.0);
+                }
+                std::hint::black_box(g.read(c).unwrap());
+            })
+        });
+        row(name, n, "akagi", rate(cpu, 60.0), gpu.map(|g| rate(g, 60.0)));
+    }
+}
+
+fn row(name: &str, n: f64, method: &str, cpu: f64, gpu: Option<f64>) {
+    match gpu {
+        Some(g) => println!("{name:<16} {n:>9} {method:<6} {cpu:>12.3} {g:>12.3} {:>9.2}×", g / cpu),
+        None => println!("{name:<16} {n:>9} {method:<6} {cpu:>12.3} {:>12} {:>10}", "–", "–"),
+    }
+}
