@@ -20,6 +20,7 @@
 //! position and orientation, plus animated Bézier control points for methods that have them.
 
 pub mod akagi;
+pub mod skjermo;
 pub mod zioma;
 
 use crate::model::Tree;

@@ -5,6 +5,7 @@ pub mod akagi;
 pub mod noise;
 pub mod pose_fk;
 mod segment_ends;
+pub mod skjermo;
 pub mod trunk_noise;
 pub mod wind_sample;
 pub mod zioma_rotations;

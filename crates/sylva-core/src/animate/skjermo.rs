@@ -1,0 +1,261 @@
+//! Skjermo's Bézier bending (§4): every stem is one cubic Bézier whose control points are
+//! re-attached to the parent's curve and bent by the wind each step.
+//!
+//! Each step, for every stem in parallel (`cpu::skjermo::skjermo_step`):
+//! 1. **Re-attach** (§4.2) on the parent's curve *from the previous step*: P0 at the attachment
+//!    parameter, the frame from the curve's derivative there and the parent's orientation
+//!    vector O (the frame `[T, N, B]` with `N` the part of O normal to T — Sloan's handle
+//!    construction, eq. 8), the stem's rest control points carried by that frame. A trunk
+//!    keeps its base.
+//! 2. **Wind**: the scene's velocity F at the re-attached tip P3.
+//! 3. **Bend** (eqs. 15–17): bend factors `b₃ = c F̂·1^e`, `b₂ = c F̂·(1/3)^e` with the
+//!    published exponent e = 1.8 (configurable), where `c = L θ` scales by the stem's length
+//!    and its static bend `θ = min(max_bend, drag · |F|²)` (drag over stiffness, as in
+//!    Zioma's method); then `P'ᵢ = P'ᵢ₋₁ + |Pᵢ − Pᵢ₋₁| · normalize(Pᵢ − Pᵢ₋₁ + bᵢ)` for
+//!    i = 2, 3, which keeps the control polygon's lengths (P0, P1 stay: the branch grows out
+//!    of its parent).
+//!
+//! Because a stem reads its parent's previous curve, motion reaches level d one step after
+//! level d − 1: **level d lags d steps** behind the trunk (§5); at 60 steps/s a four-level
+//! tree's twigs answer 50 ms late. Buffers ping-pong between steps (GPU and CPU alike).
+//!
+//! Control points are kept as displacements from rest so still air reproduces the rest
+//! curves exactly. The pose's segments turn with their stem's tangent (rest → current, at
+//! the segment's middle) through the pose seam, so lengths are kept and `Pose::bezier`
+//! carries the animated curves for the deformer.
+
+use super::Pose;
+use crate::cpu::skjermo::{skjermo_rotations, skjermo_step};
+use crate::model::{NONE, Tree};
+use crate::wind::raw::{RawField, RawWave};
+use bytemuck::{Pod, Zeroable};
+use glam::{Vec3, Vec4};
+
+/// Parameters of Skjermo's method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkjermoParams {
+    /// Exponent e of eq. 16 (published: 1.8).
+    pub exponent: f32,
+    /// Weight of P2's bend factor before the exponent (printed: 1/3).
+    pub p2_weight: f32,
+    /// Largest static bend of a stem, rad.
+    pub max_bend: f32,
+    /// Drag coefficient of bark and leaves for the static bend (as in Zioma's method).
+    pub drag: f32,
+}
+
+impl Default for SkjermoParams {
+    fn default() -> Self {
+        Self { exponent: 1.8, p2_weight: 1.0 / 3.0, max_bend: 0.6, drag: crate::animate::zioma::BRANCH_DRAG }
+    }
+}
+
+/// Per-stem constants, 160 bytes. WGSL: `SkjermoStem` in `skjermo.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawSkjermoStem {
+    /// Rest control points (xyz, w = 1).
+    pub rest: [[f32; 4]; 4],
+    /// Rest control points P0..P3 relative to the attachment point in the rest attachment
+    /// frame (xyz).
+    pub local: [[f32; 4]; 4],
+    /// Parent stem (`u32::MAX` for a trunk).
+    pub parent: u32,
+    /// Bézier parameter of the attachment on the parent.
+    pub attach: f32,
+    /// Static bend per (m/s)², rad·s²/m².
+    pub drag: f32,
+    /// Arc length, m.
+    pub length: f32,
+    /// The parent's rest orientation vector (xyz; zero for a trunk).
+    pub parent_orient: [f32; 4],
+}
+
+/// Per-stem state (what ping-pongs), 80 bytes: displacement of each control point from rest
+/// and the orientation vector O (xyz) handed to children.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawSkjermoState {
+    /// Displacements of P0..P3 (xyz).
+    pub delta: [[f32; 4]; 4],
+    /// Orientation vector O (xyz).
+    pub orient: [f32; 4],
+}
+
+/// Per-step values, 32 bytes. WGSL: `SkjermoStep`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawSkjermoStep {
+    /// Time, s.
+    pub time: f32,
+    /// Exponent e.
+    pub exponent: f32,
+    /// P2 weight.
+    pub p2_weight: f32,
+    /// Largest static bend, rad.
+    pub max_bend: f32,
+    /// Padding.
+    pub _pad: [f32; 4],
+}
+
+/// Skjermo's method set up for one tree.
+#[derive(Debug, Clone)]
+pub struct Skjermo {
+    /// Parameters.
+    pub params: SkjermoParams,
+    /// Per-stem constants.
+    pub stems: Vec<RawSkjermoStem>,
+    /// Rest orientation vector of each stem.
+    pub rest_orient: Vec<[f32; 4]>,
+    /// Per-segment (stem, Bézier parameter of the segment's middle).
+    pub segment_param: Vec<[f32; 4]>,
+}
+
+/// State: per-stem displacements (current), time and the current pose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SkjermoState {
+    /// Per-stem state.
+    pub stems: Vec<RawSkjermoState>,
+    /// Steps taken.
+    pub steps: u64,
+    /// Simulated time, s.
+    pub time: f32,
+    /// Current pose (with Béziers).
+    pub pose: Pose,
+}
+
+/// Bézier point.
+pub fn bezier(p: &[Vec3; 4], t: f32) -> Vec3 {
+    let s = 1.0 - t;
+    p[0] * (s * s * s) + p[1] * (3.0 * s * s * t) + p[2] * (3.0 * s * t * t) + p[3] * (t * t * t)
+}
+
+/// Bézier derivative.
+pub fn bezier_d(p: &[Vec3; 4], t: f32) -> Vec3 {
+    let s = 1.0 - t;
+    (p[1] - p[0]) * (3.0 * s * s) + (p[2] - p[1]) * (6.0 * s * t) + (p[3] - p[2]) * (3.0 * t * t)
+}
+
+/// The attachment frame `[T, N, B]` at `t` with orientation vector `o` (columns as arrays).
+pub fn frame(p: &[Vec3; 4], o: Vec3, t: f32) -> [Vec3; 3] {
+    let tan = crate::cpu::zioma_rotations::axis_or(bezier_d(p, t), Vec3::Y);
+    let n = crate::cpu::zioma_rotations::axis_or(
+        o - tan * o.dot(tan),
+        crate::cpu::zioma_rotations::axis_or(tan.any_orthogonal_vector(), Vec3::X),
+    );
+    [tan, n, tan.cross(n)]
+}
+
+fn closest_param(p: &[Vec3; 4], q: Vec3) -> f32 {
+    let mut best = (f32::MAX, 0.0f32);
+    for k in 0..=256 {
+        let t = k as f32 / 256.0;
+        let d = (bezier(p, t) - q).length_squared();
+        if d < best.0 {
+            best = (d, t);
+        }
+    }
+    best.1
+}
+
+impl Skjermo {
+    /// Precomputes rest control points, attachment parameters and frames.
+    pub fn new(tree: &Tree, params: SkjermoParams) -> Self {
+        let st = &tree.stems;
+        let s = &tree.segments;
+        let z = crate::animate::zioma::Zioma::new(tree, crate::animate::zioma::ZiomaParams::default());
+        let ctrl = |k: usize| st.bezier[k];
+        let mut stems = Vec::with_capacity(st.len());
+        let mut rest_orient = vec![[0.0f32; 4]; st.len()];
+        for k in 0..st.len() {
+            let p = ctrl(k);
+            let (attach, f) = if st.parent[k] == NONE {
+                let f = frame(&p, Vec3::X, 0.0);
+                (0.0, f)
+            } else {
+                let pk = st.parent[k] as usize;
+                let pp = ctrl(pk);
+                let a = closest_param(&pp, p[0]);
+                let o = Vec3::from_slice(&rest_orient[pk][..3]);
+                (a, frame(&pp, o, a))
+            };
+            // This stem's own orientation vector: its frame's normal, carried with the frame.
+            rest_orient[k] = f[1].extend(0.0).to_array();
+            let base = if st.parent[k] == NONE { p[0] } else { bezier(&ctrl(st.parent[k] as usize), attach) };
+            let local = [0, 1, 2, 3].map(|j| {
+                let d = p[j] - base;
+                Vec4::new(d.dot(f[0]), d.dot(f[1]), d.dot(f[2]), 0.0).to_array()
+            });
+            stems.push(RawSkjermoStem {
+                rest: p.map(|q| q.extend(1.0).to_array()),
+                local,
+                parent: st.parent[k],
+                attach,
+                drag: z.stems[k].drag * params.drag / crate::animate::zioma::BRANCH_DRAG,
+                length: st.length[k],
+                parent_orient: if st.parent[k] == NONE { [0.0; 4] } else { rest_orient[st.parent[k] as usize] },
+            });
+        }
+        // Each segment's middle as a parameter on its stem's curve.
+        let segment_param = (0..s.len())
+            .map(|i| {
+                let k = s.stem[i] as usize;
+                let mid = s.start[i] + s.axis(i) * (0.5 * s.length[i]);
+                [f32::from_bits(k as u32), closest_param(&ctrl(k), mid), 0.0, 0.0]
+            })
+            .collect();
+        Self { params, stems, rest_orient, segment_param }
+    }
+
+    /// The state at rest.
+    pub fn rest_state(&self, tree: &Tree) -> SkjermoState {
+        SkjermoState {
+            stems: self.rest_orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect(),
+            steps: 0,
+            time: 0.0,
+            pose: Pose { bezier: Some(tree.stems.bezier.clone()), ..Pose::rest(tree) },
+        }
+    }
+
+    /// Per-step values.
+    pub fn step_params(&self, time: f32) -> RawSkjermoStep {
+        RawSkjermoStep {
+            time,
+            exponent: self.params.exponent,
+            p2_weight: self.params.p2_weight,
+            max_bend: self.params.max_bend,
+            _pad: [0.0; 4],
+        }
+    }
+
+    /// Advances one step of `dt` seconds: all stems re-attach to their parents' previous
+    /// curves and bend (ping-pong), then the pose follows.
+    pub fn step(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
+        let t = state.time + dt;
+        let mut next = state.stems.clone();
+        skjermo_step(fields, waves, &self.stems, &state.stems, self.step_params(t), &mut next);
+        state.stems = next;
+        state.time = t;
+        state.steps += 1;
+        let mut delta = vec![[0.0f32; 4]; tree.segments.len()];
+        skjermo_rotations(
+            &tree.raw_segments(),
+            &self.segment_param,
+            &self.stems,
+            &state.stems,
+            &tree.segments.parent,
+            &mut delta,
+        );
+        let mut pose = Pose::from_rotations(tree, &delta);
+        pose.bezier = Some(
+            self.stems
+                .iter()
+                .zip(&state.stems)
+                .map(|(r, s)| {
+                    [0, 1, 2, 3].map(|j| Vec3::from_slice(&r.rest[j][..3]) + Vec3::from_slice(&s.delta[j][..3]))
+                })
+                .collect(),
+        );
+        state.pose = pose;
+    }
+}

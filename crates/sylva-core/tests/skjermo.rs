@@ -1,0 +1,132 @@
+//! Skjermo's Bézier bending.
+
+use glam::Vec3;
+use sylva_core::Tree;
+use sylva_core::animate::skjermo::{Skjermo, SkjermoParams};
+use sylva_core::animate::{Pose, displacement};
+use sylva_core::species::{PRESETS, SpeciesSource};
+use sylva_core::wind::{Constant, WindField, WindScene};
+
+fn tree(name: &str) -> Tree {
+    SpeciesSource::resolve(name).unwrap().generate(2, &Default::default(), None).unwrap()
+}
+
+fn constant(speed: f32) -> WindScene {
+    WindScene { fields: vec![WindField::Constant(Constant { direction: [1.0, 0.0, 0.0], speed })] }
+}
+
+#[test]
+fn still_air_keeps_the_exact_rest_pose_and_curves() {
+    for p in PRESETS {
+        let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
+        let m = Skjermo::new(&t, SkjermoParams::default());
+        let mut s = m.rest_state(&t);
+        let (f, w) = WindScene::default().pack();
+        for _ in 0..5 {
+            m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+        }
+        assert_eq!(s.pose.start, Pose::rest(&t).start, "{}", p.name);
+        assert_eq!(s.pose.orientation, Pose::rest(&t).orientation, "{}", p.name);
+        assert_eq!(s.pose.bezier.as_ref().unwrap(), &t.stems.bezier, "{}", p.name);
+    }
+}
+
+#[test]
+fn constant_wind_bends_downwind_more_as_it_rises() {
+    for name in ["quaking_aspen", "monopodial"] {
+        let t = tree(name);
+        let m = Skjermo::new(&t, SkjermoParams::default());
+        let mut last = 0.0;
+        for speed in [2.0, 5.0, 10.0, 20.0] {
+            let (f, w) = constant(speed).pack();
+            let mut s = m.rest_state(&t);
+            for _ in 0..30 {
+                m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+            }
+            let shift = displacement(&t, &s.pose).crown_mean;
+            assert!(shift.x > last, "{name} {speed} m/s: {shift} after {last}");
+            assert!(shift.z.abs() < 0.3 * shift.x, "{name}: {shift}");
+            last = shift.x;
+            // Control polygons keep their lengths (eq. 17).
+            let b = s.pose.bezier.as_ref().unwrap();
+            for k in 0..t.stems.len() {
+                for j in 1..4 {
+                    let rest = (t.stems.bezier[k][j] - t.stems.bezier[k][j - 1]).length();
+                    let now = (b[k][j] - b[k][j - 1]).length();
+                    assert!((now - rest).abs() <= 1e-4 * rest.max(1e-3), "{name} stem {k} leg {j}: {rest} → {now}");
+                }
+            }
+        }
+    }
+}
+
+/// A stem re-attaches to its parent's curve of the previous step, so the trunk's motion
+/// reaches level d one step after level d − 1: with only the trunk catching the wind, the
+/// base of level d first moves in step d + 1 (the trunk bends in step 1).
+#[test]
+fn each_level_lags_one_step_behind_its_parent() {
+    let t = tree("black_tupelo");
+    let mut m = Skjermo::new(&t, SkjermoParams::default());
+    for (k, st) in m.stems.iter_mut().enumerate() {
+        if t.stems.level[k] > 0 {
+            st.drag = 0.0;
+        }
+    }
+    let (f, w) = constant(12.0).pack();
+    let mut s = m.rest_state(&t);
+    let levels = t.levels as usize;
+    let mut first_move = vec![None; levels];
+    for step in 1..=8u64 {
+        m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+        let b = s.pose.bezier.as_ref().unwrap();
+        for k in 0..t.stems.len() {
+            let l = t.stems.level[k] as usize;
+            if l > 0 && first_move[l].is_none() && b[k][0] != t.stems.bezier[k][0] {
+                first_move[l] = Some(step);
+            }
+        }
+    }
+    for (l, f) in first_move.iter().enumerate().skip(1) {
+        assert_eq!(*f, Some(l as u64 + 1), "level {l} base first moved at {f:?}");
+    }
+}
+
+#[test]
+fn a_100_000_step_storm_stays_sound_and_threads_do_not_matter() {
+    let t = tree("stochastic_bush");
+    let mut wind = WindScene::resolve("gusty").unwrap();
+    if let WindField::Constant(c) = &mut wind.fields[0] {
+        c.speed = 40.0;
+    }
+    let (f, w) = wind.pack();
+    let m = Skjermo::new(&t, SkjermoParams::default());
+    let mut s = m.rest_state(&t);
+    let seg = &t.segments;
+    for k in 0..100_000 {
+        m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+        if k % 10_000 == 0 || k == 99_999 {
+            for i in 0..seg.len() {
+                assert!(s.pose.start[i].is_finite() && s.pose.orientation[i].is_finite(), "NaN at step {k}");
+                let p = seg.parent[i];
+                if p != u32::MAX && seg.stem[p as usize] == seg.stem[i] {
+                    let len = (s.pose.start[i] - s.pose.start[p as usize]).length();
+                    let tol = (1e-4 * seg.length[p as usize]).max(4.0 * f32::EPSILON * s.pose.start[i].length());
+                    assert!((len - seg.length[p as usize]).abs() <= tol, "step {k}: segment {p}");
+                }
+            }
+            assert!(s.pose.bezier.as_ref().unwrap().iter().flatten().all(|p: &Vec3| p.is_finite()));
+        }
+    }
+    let t = tree("quaking_aspen");
+    let m = Skjermo::new(&t, SkjermoParams::default());
+    let run = |n| {
+        rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap().install(|| {
+            let mut s = m.rest_state(&t);
+            for _ in 0..40 {
+                m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+            }
+            s
+        })
+    };
+    assert_eq!(run(1), run(3));
+}
