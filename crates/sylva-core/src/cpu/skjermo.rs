@@ -38,11 +38,11 @@ pub fn skjermo_step(
         };
         // Unbent control points re-attached, as displacements from rest.
         let mut d = [shift; 4];
-        for j in 0..4 {
-            let l = v3(st.local[j]);
+        for (dj, lj) in d.iter_mut().zip(&st.local) {
+            let l = v3(*lj);
             let now = f_now[0] * l.x + f_now[1] * l.y + f_now[2] * l.z;
             let was = f_rest[0] * l.x + f_rest[1] * l.y + f_rest[2] * l.z;
-            d[j] = shift + (now - was);
+            *dj = shift + (now - was);
         }
         // Wind at the tip, bend factors (eq. 16), length-keeping update (eq. 17).
         let a = [0, 1, 2, 3].map(|j| rest[j] + d[j]);
