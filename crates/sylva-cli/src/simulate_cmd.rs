@@ -7,6 +7,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 use sylva_core::animate::akagi::{Akagi, AkagiParams};
+use sylva_core::animate::skjermo::{Skjermo, SkjermoParams};
 use sylva_core::animate::zioma::{Lod, Zioma, ZiomaParams};
 use sylva_core::animate::{Pose, displacement};
 use sylva_core::species::{DEFAULT_SPECIES, SpeciesSource};
@@ -20,6 +21,8 @@ pub enum Method {
     Zioma,
     /// Akagi & Kitajima §2.5: wind forces propagated to the root, damped angular springs.
     Akagi,
+    /// Skjermo §4: one Bézier per stem, re-attached and bent by the wind each step.
+    Skjermo,
 }
 
 /// Where to run.
@@ -139,6 +142,26 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
                     method.step(tree_ref, &fields, &waves, &mut state, dt);
                 }
                 Ok(state.pose.clone())
+            })
+        }
+        (Method::Skjermo, None) => {
+            let method = Skjermo::new(tree_ref, SkjermoParams::default());
+            let mut state = method.rest_state(tree_ref);
+            Box::new(move |_, dt| {
+                if dt > 0.0 {
+                    method.step(tree_ref, &fields, &waves, &mut state, dt);
+                }
+                Ok(state.pose.clone())
+            })
+        }
+        (Method::Skjermo, Some(ctx)) => {
+            let method = Skjermo::new(tree_ref, SkjermoParams::default());
+            let mut g = sylva_gpu::pose::GpuSkjermo::new(ctx, tree_ref, &method, wind_ref)?;
+            Box::new(move |_, dt| {
+                if dt > 0.0 {
+                    g.step(ctx, dt);
+                }
+                Ok(g.read(ctx, &method)?)
             })
         }
         (Method::Akagi, Some(ctx)) => {

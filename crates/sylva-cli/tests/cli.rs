@@ -181,6 +181,12 @@ fn simulate_runs_akagi_too() {
     );
     assert!(ok, "{err}");
     assert!(out.contains("Akagi on Cpu") && out.contains("31 frames"), "{out}");
+    let (ok, out, err) = sylva(
+        dir.path(),
+        &["simulate", "--method", "skjermo", "--species", "monopodial", "--seconds", "1", "--fps", "30"],
+    );
+    assert!(ok, "{err}");
+    assert!(out.contains("Skjermo on Cpu"), "{out}");
     let (ok, _, err) = sylva(dir.path(), &["simulate", "--method", "akagi", "--trunk-only"]);
     assert!(!ok && err.contains("--trunk-only"), "{err}");
 }

@@ -81,6 +81,63 @@ fn main() {
         });
         row(name, n, "akagi", rate(cpu, 60.0), gpu.map(|g| rate(g, 60.0)));
     }
+    skjermo_table(ctx, "`gusty` (72 terms)", WindScene::resolve("gusty").unwrap());
+    // The paper's setting: four sines (eqs. 11-14).
+    let sines = WindScene::from_toml(
+        "[[field]]\nkind = \"sum_of_sines\"\nsharpness = 2.0\nwaves = [\n\
+         { amplitude = 4.0, direction_deg = 0.0, wavelength = 40.0, speed = 6.0 },\n\
+         { amplitude = 2.0, direction_deg = 30.0, wavelength = 17.0, speed = 4.0 },\n\
+         { amplitude = 1.0, direction_deg = -25.0, wavelength = 9.0, speed = 3.0 },\n\
+         { amplitude = 0.5, direction_deg = 60.0, wavelength = 5.0, speed = 2.0 },\n]\n",
+        "sines.toml",
+    )
+    .unwrap();
+    skjermo_table(ctx, "four sines (the paper's setting)", sines);
+}
+
+/// Skjermo's figure: branches updated per second (the step: re-attach, sample the wind,
+/// bend), on binary trees of 65,535 and 262,143 one-segment stems (paper: 65,536 branches
+/// at 600 updates/s and 262,144 at 180/s on a GeForce 7900 GTX).
+fn skjermo_table(ctx: Option<&'static GpuContext>, wind_name: &str, wind: WindScene) {
+    use sylva_core::animate::skjermo::{Skjermo, SkjermoParams};
+    use sylva_core::{Grammar, LSystemOptions};
+    let (fields, waves) = wind.pack();
+    println!("\nSkjermo step (branches updated per second), wind {wind_name}");
+    println!("{:>9} {:>14} {:>14} {:>10}   paper (7900 GTX)", "branches", "cpu updates/s", "gpu updates/s", "gpu/cpu");
+    for (iterations, paper) in [(16u32, 600.0), (18, 180.0)] {
+        let g =
+            Grammar::parse("axiom: A(1)\nA(l) -> F(l)[+(30)A(l*0.8)][-(30)/(90)A(l*0.8)]\n", "binary.lsys").unwrap();
+        let t = g.generate(&LSystemOptions { seed: 1, iterations: Some(iterations), ..Default::default() }).unwrap();
+        let m = Skjermo::new(&t, SkjermoParams::default());
+        let state = m.rest_state(&t);
+        let mut next = state.stems.clone();
+        let n = t.stems.len();
+        let cpu = time(7, || {
+            sylva_core::cpu::skjermo::skjermo_step(
+                &fields,
+                &waves,
+                &m.stems,
+                &state.stems,
+                m.step_params(1.0),
+                &mut next,
+            );
+        });
+        let cpu_rate = 1.0 / cpu.as_secs_f64();
+        let gpu_rate = ctx.map(|c| {
+            let mut g = sylva_gpu::pose::GpuSkjermo::new(c, &t, &m, &wind).unwrap();
+            let d = time(3, || {
+                for _ in 0..20 {
+                    g.step_only(c, 1.0 / 60.0);
+                }
+                c.wait().unwrap();
+            });
+            20.0 / d.as_secs_f64()
+        });
+        match gpu_rate {
+            Some(gr) => println!("{n:>9} {cpu_rate:>14.1} {gr:>14.1} {:>9.2}×   {paper} updates/s", gr / cpu_rate),
+            None => println!("{n:>9} {cpu_rate:>14.1} {:>14} {:>10}   {paper} updates/s", "–", "–"),
+        }
+    }
 }
 
 fn row(name: &str, n: f64, method: &str, cpu: f64, gpu: Option<f64>) {

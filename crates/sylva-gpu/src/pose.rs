@@ -270,3 +270,116 @@ impl GpuAkagi {
         self.pose.read(ctx)
     }
 }
+
+/// Skjermo's method on the GPU: the step (ping-pong state buffers), the seam rotations and
+/// forward kinematics in one submission per step.
+#[derive(Debug)]
+pub struct GpuSkjermo {
+    step_kernel: Arc<Kernel>,
+    rotations: Arc<Kernel>,
+    pose: GpuPose,
+    fields: wgpu::Buffer,
+    waves: wgpu::Buffer,
+    stems: wgpu::Buffer,
+    params: wgpu::Buffer,
+    step: wgpu::Buffer,
+    state: [wgpu::Buffer; 2],
+    current: usize,
+    n_stems: usize,
+    method_step: sylva_core::animate::skjermo::RawSkjermoStep,
+    /// Simulated time, s.
+    pub time: f32,
+}
+
+impl GpuSkjermo {
+    /// Uploads the tree, Skjermo's constants and the wind; the state starts at rest.
+    pub fn new(
+        ctx: &GpuContext,
+        tree: &Tree,
+        method: &sylva_core::animate::skjermo::Skjermo,
+        wind: &WindScene,
+    ) -> Result<Self, GpuError> {
+        use crate::shader::{SKJERMO, SKJERMO_ROTATIONS, SKJERMO_STEP};
+        use sylva_core::animate::skjermo::RawSkjermoState;
+        let (fields, waves) = wind.pack();
+        let zero_field =
+            [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
+        let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
+        let rest: Vec<RawSkjermoState> =
+            method.rest_orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect();
+        Ok(Self {
+            step_kernel: Kernel::cached(ctx, "skjermo_step", &[QUAT, TREE, NOISE, WIND, SKJERMO, SKJERMO_STEP]),
+            rotations: Kernel::cached(ctx, "skjermo_rotations", &[QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS]),
+            pose: GpuPose::new(ctx, tree)?,
+            fields: upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { &fields })?,
+            waves: upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { &waves })?,
+            stems: upload(ctx, "skjermo stems", &method.stems)?,
+            params: upload(ctx, "segment params", &method.segment_param)?,
+            step: upload(ctx, "skjermo step", &[method.step_params(0.0)])?,
+            state: [upload(ctx, "skjermo state a", &rest)?, upload(ctx, "skjermo state b", &rest)?],
+            current: 0,
+            n_stems: method.stems.len(),
+            method_step: method.step_params(0.0),
+            time: 0.0,
+        })
+    }
+
+    /// Advances by one step of `dt` seconds (submitted, not waited for).
+    pub fn step(&mut self, ctx: &GpuContext, dt: f32) {
+        self.time += dt;
+        let step = sylva_core::animate::skjermo::RawSkjermoStep { time: self.time, ..self.method_step };
+        ctx.queue.write_buffer(&self.step, 0, bytemuck::bytes_of(&step));
+        let (prev, next) = (&self.state[self.current], &self.state[1 - self.current]);
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        self.step_kernel.record(
+            ctx,
+            &mut e,
+            &[&self.fields, &self.waves, &self.stems, prev, &self.step, next],
+            self.n_stems as u32,
+        );
+        self.rotations.record(
+            ctx,
+            &mut e,
+            &[&self.params, &self.stems, next, &self.pose.parents, &self.pose.delta],
+            self.pose.n as u32,
+        );
+        self.pose.record(ctx, &mut e);
+        ctx.queue.submit([e.finish()]);
+        self.current = 1 - self.current;
+    }
+
+    /// Advances the curves only (no pose): Skjermo's branch update as the paper measures it.
+    pub fn step_only(&mut self, ctx: &GpuContext, dt: f32) {
+        self.time += dt;
+        let step = sylva_core::animate::skjermo::RawSkjermoStep { time: self.time, ..self.method_step };
+        ctx.queue.write_buffer(&self.step, 0, bytemuck::bytes_of(&step));
+        let (prev, next) = (&self.state[self.current], &self.state[1 - self.current]);
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        self.step_kernel.record(
+            ctx,
+            &mut e,
+            &[&self.fields, &self.waves, &self.stems, prev, &self.step, next],
+            self.n_stems as u32,
+        );
+        ctx.queue.submit([e.finish()]);
+        self.current = 1 - self.current;
+    }
+
+    /// Reads the current pose back, with the animated Béziers (waits for the GPU).
+    pub fn read(&self, ctx: &GpuContext, method: &sylva_core::animate::skjermo::Skjermo) -> Result<Pose, GpuError> {
+        let mut pose = self.pose.read(ctx)?;
+        let state: Vec<sylva_core::animate::skjermo::RawSkjermoState> =
+            read_back(ctx, &self.state[self.current], self.n_stems)?;
+        pose.bezier = Some(
+            method
+                .stems
+                .iter()
+                .zip(&state)
+                .map(|(r, s)| {
+                    [0, 1, 2, 3].map(|j| Vec3::from_slice(&r.rest[j][..3]) + Vec3::from_slice(&s.delta[j][..3]))
+                })
+                .collect(),
+        );
+        Ok(pose)
+    }
+}

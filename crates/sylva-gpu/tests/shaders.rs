@@ -170,3 +170,103 @@ fn wind_and_noise_structs_match_their_wgsl_twins() {
         ],
     );
 }
+
+#[test]
+fn animation_structs_match_their_wgsl_twins() {
+    use sylva_core::animate::akagi::{RawAkagiSegment, RawAkagiStep};
+    use sylva_core::animate::skjermo::{RawSkjermoState, RawSkjermoStem, RawSkjermoStep};
+    use sylva_core::animate::zioma::{RawZiomaFrame, RawZiomaStem};
+    use sylva_gpu::shader::{AKAGI, NOISE, QUAT, SKJERMO, TREE, WIND, ZIOMA_ROTATIONS};
+    let zioma = compose(&[QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS]);
+    check_in(
+        &zioma,
+        "ZiomaStem",
+        size_of::<RawZiomaStem>(),
+        &[
+            ("base", offset_of!(RawZiomaStem, base)),
+            ("drag", offset_of!(RawZiomaStem, drag)),
+            ("dir", offset_of!(RawZiomaStem, dir)),
+            ("freq", offset_of!(RawZiomaStem, freq)),
+            ("parent_axis", offset_of!(RawZiomaStem, parent_axis)),
+            ("phase", offset_of!(RawZiomaStem, phase)),
+            ("level", offset_of!(RawZiomaStem, level)),
+            ("seed", offset_of!(RawZiomaStem, seed)),
+            ("length", offset_of!(RawZiomaStem, length)),
+            ("_pad", offset_of!(RawZiomaStem, _pad)),
+        ],
+    );
+    check_in(
+        &zioma,
+        "ZiomaFrame",
+        size_of::<RawZiomaFrame>(),
+        &[
+            ("wind_dir", offset_of!(RawZiomaFrame, wind_dir)),
+            ("time", offset_of!(RawZiomaFrame, time)),
+            ("trunk", offset_of!(RawZiomaFrame, trunk)),
+            ("trunk_rate", offset_of!(RawZiomaFrame, trunk_rate)),
+            ("lod", offset_of!(RawZiomaFrame, lod)),
+            ("amplitude", offset_of!(RawZiomaFrame, amplitude)),
+            ("max_bend", offset_of!(RawZiomaFrame, max_bend)),
+            ("inertia", offset_of!(RawZiomaFrame, inertia)),
+        ],
+    );
+    check_in(
+        AKAGI,
+        "AkagiSegment",
+        size_of::<RawAkagiSegment>(),
+        &[
+            ("bark_area", offset_of!(RawAkagiSegment, bark_area)),
+            ("leaf_area", offset_of!(RawAkagiSegment, leaf_area)),
+            ("inertia", offset_of!(RawAkagiSegment, inertia)),
+            ("stiffness", offset_of!(RawAkagiSegment, stiffness)),
+            ("damping", offset_of!(RawAkagiSegment, damping)),
+            ("_pad", offset_of!(RawAkagiSegment, _pad)),
+        ],
+    );
+    check_in(
+        AKAGI,
+        "AkagiStep",
+        size_of::<RawAkagiStep>(),
+        &[
+            ("drag", offset_of!(RawAkagiStep, drag)),
+            ("time", offset_of!(RawAkagiStep, time)),
+            ("dt", offset_of!(RawAkagiStep, dt)),
+            ("reconfiguration_speed", offset_of!(RawAkagiStep, reconfiguration_speed)),
+            ("stiffening_angle", offset_of!(RawAkagiStep, stiffening_angle)),
+            ("_pad", offset_of!(RawAkagiStep, _pad)),
+        ],
+    );
+    let skjermo = compose(&[QUAT, TREE, SKJERMO]);
+    check_in(
+        &skjermo,
+        "SkjermoStem",
+        size_of::<RawSkjermoStem>(),
+        &[
+            ("rest", offset_of!(RawSkjermoStem, rest)),
+            ("local", offset_of!(RawSkjermoStem, local)),
+            ("parent", offset_of!(RawSkjermoStem, parent)),
+            ("attach", offset_of!(RawSkjermoStem, attach)),
+            ("drag", offset_of!(RawSkjermoStem, drag)),
+            ("length", offset_of!(RawSkjermoStem, length)),
+            ("parent_orient", offset_of!(RawSkjermoStem, parent_orient)),
+        ],
+    );
+    check_in(
+        &skjermo,
+        "SkjermoState",
+        size_of::<RawSkjermoState>(),
+        &[("delta", offset_of!(RawSkjermoState, delta)), ("orient", offset_of!(RawSkjermoState, orient))],
+    );
+    check_in(
+        &skjermo,
+        "SkjermoStep",
+        size_of::<RawSkjermoStep>(),
+        &[
+            ("time", offset_of!(RawSkjermoStep, time)),
+            ("exponent", offset_of!(RawSkjermoStep, exponent)),
+            ("p2_weight", offset_of!(RawSkjermoStep, p2_weight)),
+            ("max_bend", offset_of!(RawSkjermoStep, max_bend)),
+            ("_pad", offset_of!(RawSkjermoStep, _pad)),
+        ],
+    );
+}

@@ -238,14 +238,7 @@ impl Skjermo {
         state.time = t;
         state.steps += 1;
         let mut delta = vec![[0.0f32; 4]; tree.segments.len()];
-        skjermo_rotations(
-            &tree.raw_segments(),
-            &self.segment_param,
-            &self.stems,
-            &state.stems,
-            &tree.segments.parent,
-            &mut delta,
-        );
+        skjermo_rotations(&self.segment_param, &self.stems, &state.stems, &tree.segments.parent, &mut delta);
         let mut pose = Pose::from_rotations(tree, &delta);
         pose.bezier = Some(
             self.stems

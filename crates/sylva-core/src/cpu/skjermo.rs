@@ -3,7 +3,7 @@
 
 use crate::animate::skjermo::{RawSkjermoState, RawSkjermoStem, RawSkjermoStep, bezier, bezier_d, frame};
 use crate::cpu::wind_sample::wind_at;
-use crate::model::{NONE, RawSegment};
+use crate::model::NONE;
 use crate::wind::raw::{RawField, RawWave};
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
@@ -92,10 +92,9 @@ pub fn shortest_arc(a: Vec3, b: Vec3) -> Quat {
 }
 
 /// Per-segment seam rotations δᵢ = R_parent⁻¹ Rᵢ, so that the seam's accumulated rotation of
-/// every segment is its own Rᵢ. Bindings: 0 segments, 1 segment params, 2 stems, 3 state,
-/// 4 parents, 5 δ.
+/// every segment is its own Rᵢ. Bindings: 0 segment params, 1 stems, 2 state, 3 parents,
+/// 4 δ.
 pub fn skjermo_rotations(
-    segments: &[RawSegment],
     params: &[[f32; 4]],
     stems: &[RawSkjermoStem],
     state: &[RawSkjermoState],
@@ -103,7 +102,6 @@ pub fn skjermo_rotations(
     out: &mut [[f32; 4]],
 ) {
     out.par_iter_mut().enumerate().for_each(|(i, o)| {
-        let _ = &segments[i];
         let r = segment_rotation(params[i], stems, state);
         let p = parents[i];
         let d = if p == NONE { r } else { segment_rotation(params[p as usize], stems, state).inverse() * r };

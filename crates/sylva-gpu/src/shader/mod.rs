@@ -27,6 +27,12 @@ pub const AKAGI_FORCES: &str = include_str!("akagi_forces.wgsl");
 pub const AKAGI_SUBTREE: &str = include_str!("akagi_subtree.wgsl");
 /// Kernel: Akagi's damped angular springs.
 pub const AKAGI_INTEGRATE: &str = include_str!("akagi_integrate.wgsl");
+/// Skjermo's shared structs and Bézier helpers.
+pub const SKJERMO: &str = include_str!("skjermo.wgsl");
+/// Kernel: Skjermo's re-attachment and bending.
+pub const SKJERMO_STEP: &str = include_str!("skjermo_step.wgsl");
+/// Kernel: seam rotations from Skjermo's curves.
+pub const SKJERMO_ROTATIONS: &str = include_str!("skjermo_rotations.wgsl");
 /// Kernel: trunk noise bands at many (t, tree) samples.
 pub const TRUNK_NOISE: &str = include_str!("trunk_noise.wgsl");
 
@@ -41,6 +47,8 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("akagi_forces", &[QUAT, TREE, NOISE, WIND, AKAGI, AKAGI_FORCES]),
     ("akagi_subtree", &[AKAGI_SUBTREE]),
     ("akagi_integrate", &[QUAT, TREE, AKAGI, AKAGI_INTEGRATE]),
+    ("skjermo_step", &[QUAT, TREE, NOISE, WIND, SKJERMO, SKJERMO_STEP]),
+    ("skjermo_rotations", &[QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS]),
 ];
 
 /// Concatenates WGSL sources into one module.

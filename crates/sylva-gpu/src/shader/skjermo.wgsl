@@ -1,0 +1,90 @@
+// Shared by Skjermo's kernels: structs and Bezier helpers. Twins:
+// sylva_core::animate::skjermo::{RawSkjermoStem, RawSkjermoState, RawSkjermoStep, bezier,
+// bezier_d, frame}.
+
+struct SkjermoStem {
+    rest: array<vec4<f32>, 4>,
+    local: array<vec4<f32>, 4>,
+    parent: u32,
+    attach: f32,
+    drag: f32,
+    length: f32,
+    parent_orient: vec4<f32>,
+}
+
+struct SkjermoState {
+    delta: array<vec4<f32>, 4>,
+    orient: vec4<f32>,
+}
+
+struct SkjermoStep {
+    time: f32,
+    exponent: f32,
+    p2_weight: f32,
+    max_bend: f32,
+    _pad: vec4<f32>,
+}
+
+struct Curve {
+    p: array<vec3<f32>, 4>,
+}
+
+fn bezier(c: Curve, t: f32) -> vec3<f32> {
+    let s = 1.0 - t;
+    return c.p[0] * (s * s * s) + c.p[1] * (3.0 * s * s * t) + c.p[2] * (3.0 * s * t * t) + c.p[3] * (t * t * t);
+}
+
+fn bezier_d(c: Curve, t: f32) -> vec3<f32> {
+    let s = 1.0 - t;
+    return (c.p[1] - c.p[0]) * (3.0 * s * s) + (c.p[2] - c.p[1]) * (6.0 * s * t) + (c.p[3] - c.p[2]) * (3.0 * t * t);
+}
+
+fn unit_or(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
+    let l = length(v);
+    if (l > 1e-6) {
+        return v / l;
+    }
+    return fallback;
+}
+
+// glam's Vec3::any_orthogonal_vector.
+fn any_orthogonal(v: vec3<f32>) -> vec3<f32> {
+    if (abs(v.x) > abs(v.y)) {
+        return vec3<f32>(-v.z, 0.0, v.x);
+    }
+    return vec3<f32>(0.0, v.z, -v.y);
+}
+
+struct Frame {
+    t: vec3<f32>,
+    n: vec3<f32>,
+    b: vec3<f32>,
+}
+
+fn frame(c: Curve, o: vec3<f32>, t: f32) -> Frame {
+    let tan = unit_or(bezier_d(c, t), vec3<f32>(0.0, 1.0, 0.0));
+    let n = unit_or(o - tan * dot(o, tan), unit_or(any_orthogonal(tan), vec3<f32>(1.0, 0.0, 0.0)));
+    return Frame(tan, n, cross(tan, n));
+}
+
+fn rest_curve(s: SkjermoStem) -> Curve {
+    return Curve(array<vec3<f32>, 4>(s.rest[0].xyz, s.rest[1].xyz, s.rest[2].xyz, s.rest[3].xyz));
+}
+
+fn now_curve(s: SkjermoStem, st: SkjermoState) -> Curve {
+    return Curve(array<vec3<f32>, 4>(
+        s.rest[0].xyz + st.delta[0].xyz,
+        s.rest[1].xyz + st.delta[1].xyz,
+        s.rest[2].xyz + st.delta[2].xyz,
+        s.rest[3].xyz + st.delta[3].xyz,
+    ));
+}
+
+// Rotation taking unit a onto unit b: normalize(a x b, 1 + a.b); identity when a == b.
+fn shortest_arc(a: vec3<f32>, b: vec3<f32>) -> vec4<f32> {
+    let w = 1.0 + dot(a, b);
+    if (all(a == vec3<f32>(0.0)) || all(b == vec3<f32>(0.0)) || w < 1e-6) {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    return normalize(vec4<f32>(cross(a, b), w));
+}
