@@ -49,10 +49,10 @@ fn constant_wind_bends_downwind_more_as_it_rises() {
             last = shift.x;
             // Control polygons keep their lengths (eq. 17).
             let b = s.pose.bezier.as_ref().unwrap();
-            for k in 0..t.stems.len() {
+            for (k, (bk, rk)) in b.iter().zip(&t.stems.bezier).enumerate() {
                 for j in 1..4 {
-                    let rest = (t.stems.bezier[k][j] - t.stems.bezier[k][j - 1]).length();
-                    let now = (b[k][j] - b[k][j - 1]).length();
+                    let rest = (rk[j] - rk[j - 1]).length();
+                    let now = (bk[j] - bk[j - 1]).length();
                     assert!((now - rest).abs() <= 1e-4 * rest.max(1e-3), "{name} stem {k} leg {j}: {rest} → {now}");
                 }
             }
@@ -79,9 +79,9 @@ fn each_level_lags_one_step_behind_its_parent() {
     for step in 1..=8u64 {
         m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
         let b = s.pose.bezier.as_ref().unwrap();
-        for k in 0..t.stems.len() {
+        for (k, bk) in b.iter().enumerate() {
             let l = t.stems.level[k] as usize;
-            if l > 0 && first_move[l].is_none() && b[k][0] != t.stems.bezier[k][0] {
+            if l > 0 && first_move[l].is_none() && bk[0] != t.stems.bezier[k][0] {
                 first_move[l] = Some(step);
             }
         }
