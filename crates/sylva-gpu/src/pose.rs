@@ -95,14 +95,12 @@ impl GpuZioma {
     /// Uploads the tree, Zioma's per-stem constants and the wind scene.
     pub fn new(ctx: &GpuContext, tree: &Tree, method: &Zioma, wind: &WindScene) -> Result<Self, GpuError> {
         let (fields, waves) = wind.pack();
-        let zero_field =
-            [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
-        let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
+        let (wind_fields, wind_waves) = crate::wind_sample::upload_wind(ctx, &fields, &waves)?;
         Ok(Self {
             kernel: Kernel::cached(ctx, "zioma_rotations", &[QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS]),
             pose: GpuPose::new(ctx, tree)?,
-            fields: upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { &fields })?,
-            waves: upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { &waves })?,
+            fields: wind_fields,
+            waves: wind_waves,
             segments: upload(ctx, "segments", &tree.raw_segments())?,
             stems: upload(ctx, "zioma stems", &method.stems)?,
             frame: upload(ctx, "zioma frame", &[RawZiomaFrame::default_zeroed()])?,
@@ -174,9 +172,7 @@ impl GpuAkagi {
     ) -> Result<Self, GpuError> {
         use crate::shader::{AKAGI, AKAGI_FORCES, AKAGI_INTEGRATE, AKAGI_SUBTREE};
         let (fields, waves) = wind.pack();
-        let zero_field =
-            [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
-        let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
+        let (wind_fields, wind_waves) = crate::wind_sample::upload_wind(ctx, &fields, &waves)?;
         let n = tree.segments.len();
         let pose = GpuPose::new(ctx, tree)?;
         // The pose seam's accumulated rotations start at the identity.
@@ -190,8 +186,8 @@ impl GpuAkagi {
             subtree: Kernel::cached(ctx, "akagi_subtree", &[AKAGI_SUBTREE]),
             integrate: Kernel::cached(ctx, "akagi_integrate", &[QUAT, TREE, AKAGI, AKAGI_INTEGRATE]),
             pose,
-            fields: upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { &fields })?,
-            waves: upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { &waves })?,
+            fields: wind_fields,
+            waves: wind_waves,
             segments: upload(ctx, "segments", &tree.raw_segments())?,
             akagi: upload(ctx, "akagi segments", &method.segments)?,
             step: upload(ctx, "akagi step", &[method.step_params(0.0, 0.0)])?,
@@ -302,17 +298,15 @@ impl GpuSkjermo {
         use crate::shader::{SKJERMO, SKJERMO_ROTATIONS, SKJERMO_STEP};
         use sylva_core::animate::skjermo::RawSkjermoState;
         let (fields, waves) = wind.pack();
-        let zero_field =
-            [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
-        let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
+        let (wind_fields, wind_waves) = crate::wind_sample::upload_wind(ctx, &fields, &waves)?;
         let rest: Vec<RawSkjermoState> =
             method.rest_orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect();
         Ok(Self {
             step_kernel: Kernel::cached(ctx, "skjermo_step", &[QUAT, TREE, NOISE, WIND, SKJERMO, SKJERMO_STEP]),
             rotations: Kernel::cached(ctx, "skjermo_rotations", &[QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS]),
             pose: GpuPose::new(ctx, tree)?,
-            fields: upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { &fields })?,
-            waves: upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { &waves })?,
+            fields: wind_fields,
+            waves: wind_waves,
             stems: upload(ctx, "skjermo stems", &method.stems)?,
             params: upload(ctx, "segment params", &method.segment_param)?,
             step: upload(ctx, "skjermo step", &[method.step_params(0.0)])?,

@@ -6,6 +6,22 @@ use crate::{GpuContext, GpuError};
 use sylva_core::wind::WindScene;
 use sylva_core::wind::raw::{RawField, RawWave};
 
+/// Uploads a packed wind scene as the (fields, waves) storage buffers that `wind.wgsl` binds
+/// at 0 and 1. An empty scene is bound as one zero constant field (bindings cannot be empty).
+pub fn upload_wind(
+    ctx: &GpuContext,
+    fields: &[RawField],
+    waves: &[RawWave],
+) -> Result<(wgpu::Buffer, wgpu::Buffer), GpuError> {
+    let zero_field =
+        [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
+    let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
+    Ok((
+        upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { fields })?,
+        upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { waves })?,
+    ))
+}
+
 /// A scene uploaded once, sampled many times.
 #[derive(Debug)]
 pub struct WindSampler {
@@ -23,11 +39,7 @@ impl WindSampler {
 
     /// From packed fields and waves. An empty scene is bound as one zero constant field.
     pub fn from_raw(ctx: &GpuContext, fields: &[RawField], waves: &[RawWave]) -> Result<Self, GpuError> {
-        let zero_field =
-            [RawField { kind: 0, wave_offset: 0, wave_count: 0, _pad: 0, a: [0.0; 4], b: [0.0; 4], c: [0.0; 4] }];
-        let zero_wave = [RawWave { dir: [0.0; 4], k: [0.0; 4], phase: [0.0; 4] }];
-        let fields = upload(ctx, "wind fields", if fields.is_empty() { &zero_field } else { fields })?;
-        let waves = upload(ctx, "wind waves", if waves.is_empty() { &zero_wave } else { waves })?;
+        let (fields, waves) = upload_wind(ctx, fields, waves)?;
         Ok(Self { kernel: Kernel::cached(ctx, "wind_sample", &[NOISE, WIND, WIND_SAMPLE]), fields, waves })
     }
 
