@@ -127,7 +127,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
             };
             let method = Zioma::new(tree_ref, params);
             match ctx {
-                None => Box::new(move |t, _| Ok(method.pose(tree_ref, wind_ref, t))),
+                None => Box::new(move |t, _| Ok(method.pose_packed(tree_ref, &fields, &waves, t))),
                 Some(ctx) => {
                     let g = sylva_gpu::pose::GpuZioma::new(ctx, tree_ref, &method, wind_ref)?;
                     Box::new(move |t, _| Ok(g.pose(ctx, tree_ref, &method, t)?))

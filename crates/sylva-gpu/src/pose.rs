@@ -320,30 +320,15 @@ impl GpuSkjermo {
 
     /// Advances by one step of `dt` seconds (submitted, not waited for).
     pub fn step(&mut self, ctx: &GpuContext, dt: f32) {
-        self.time += dt;
-        let step = sylva_core::animate::skjermo::RawSkjermoStep { time: self.time, ..self.method_step };
-        ctx.queue.write_buffer(&self.step, 0, bytemuck::bytes_of(&step));
-        let (prev, next) = (&self.state[self.current], &self.state[1 - self.current]);
-        let mut e = ctx.device.create_command_encoder(&Default::default());
-        self.step_kernel.record(
-            ctx,
-            &mut e,
-            &[&self.fields, &self.waves, &self.stems, prev, &self.step, next],
-            self.n_stems as u32,
-        );
-        self.rotations.record(
-            ctx,
-            &mut e,
-            &[&self.params, &self.stems, next, &self.pose.parents, &self.pose.delta],
-            self.pose.n as u32,
-        );
-        self.pose.record(ctx, &mut e);
-        ctx.queue.submit([e.finish()]);
-        self.current = 1 - self.current;
+        self.advance(ctx, dt, true);
     }
 
     /// Advances the curves only (no pose): Skjermo's branch update as the paper measures it.
     pub fn step_only(&mut self, ctx: &GpuContext, dt: f32) {
+        self.advance(ctx, dt, false);
+    }
+
+    fn advance(&mut self, ctx: &GpuContext, dt: f32, with_pose: bool) {
         self.time += dt;
         let step = sylva_core::animate::skjermo::RawSkjermoStep { time: self.time, ..self.method_step };
         ctx.queue.write_buffer(&self.step, 0, bytemuck::bytes_of(&step));
@@ -355,6 +340,15 @@ impl GpuSkjermo {
             &[&self.fields, &self.waves, &self.stems, prev, &self.step, next],
             self.n_stems as u32,
         );
+        if with_pose {
+            self.rotations.record(
+                ctx,
+                &mut e,
+                &[&self.params, &self.stems, next, &self.pose.parents, &self.pose.delta],
+                self.pose.n as u32,
+            );
+            self.pose.record(ctx, &mut e);
+        }
         ctx.queue.submit([e.finish()]);
         self.current = 1 - self.current;
     }

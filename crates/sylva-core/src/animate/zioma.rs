@@ -125,6 +125,7 @@ pub struct Zioma {
     /// Point where the trunk's wind is sampled (crown centre), m.
     pub crown_centre: Vec3,
     tree_seed: u32,
+    raw: Vec<crate::model::RawSegment>,
 }
 
 impl Zioma {
@@ -178,7 +179,7 @@ impl Zioma {
             0.5 * (lo.y + hi.y) + 0.25 * (hi.y - lo.y),
             tree.segments.start.first().map_or(0.0, |p| p.z),
         );
-        Self { params, stems, crown_centre, tree_seed: mix64(params.seed) as u32 }
+        Self { params, stems, crown_centre, tree_seed: mix64(params.seed) as u32, raw: tree.raw_segments() }
     }
 
     /// The per-frame values at time `t`: wind at the crown, trunk angles and their rate.
@@ -206,14 +207,24 @@ impl Zioma {
     /// Per-segment rotations δ at time `t` (CPU reference).
     pub fn rotations(&self, tree: &Tree, wind: &WindScene, t: f32) -> Vec<[f32; 4]> {
         let (fields, waves) = wind.pack();
-        let frame = self.frame(tree, &fields, &waves, t);
+        self.rotations_packed(tree, &fields, &waves, t)
+    }
+
+    /// [`Self::rotations`] with a scene packed once by the caller.
+    pub fn rotations_packed(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], t: f32) -> Vec<[f32; 4]> {
+        let frame = self.frame(tree, fields, waves, t);
         let mut out = vec![[0.0; 4]; tree.segments.len()];
-        zioma_rotations(&fields, &waves, &tree.raw_segments(), &self.stems, &frame, &mut out);
+        zioma_rotations(fields, waves, &self.raw, &self.stems, &frame, &mut out);
         out
     }
 
     /// The pose at time `t` (CPU reference).
     pub fn pose(&self, tree: &Tree, wind: &WindScene, t: f32) -> Pose {
         Pose::from_rotations(tree, &self.rotations(tree, wind, t))
+    }
+
+    /// [`Self::pose`] with a scene packed once by the caller (per-frame loops).
+    pub fn pose_packed(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], t: f32) -> Pose {
+        Pose::from_rotations(tree, &self.rotations_packed(tree, fields, waves, t))
     }
 }
