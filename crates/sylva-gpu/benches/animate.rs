@@ -81,6 +81,8 @@ fn main() {
         });
         row(name, n, "akagi", rate(cpu, 60.0), gpu.map(|g| rate(g, 60.0)));
     }
+    fk_table(ctx);
+    zioma_instances_table(ctx, &wind);
     skjermo_table(ctx, "`gusty` (72 terms)", WindScene::resolve("gusty").unwrap());
     // The paper's setting: four sines (eqs. 11-14).
     let sines = WindScene::from_toml(
@@ -103,16 +105,23 @@ fn skjermo_table(ctx: Option<&'static GpuContext>, wind_name: &str, wind: WindSc
     use sylva_core::{Grammar, LSystemOptions};
     let (fields, waves) = wind.pack();
     println!("\nSkjermo step (branches updated per second), wind {wind_name}");
-    println!("{:>9} {:>14} {:>14} {:>10}   paper (7900 GTX)", "branches", "cpu updates/s", "gpu updates/s", "gpu/cpu");
+    println!(
+        "{:>9} {:>14} {:>14} {:>14} {:>10}   paper (7900 GTX)",
+        "branches", "cpu updates/s", "cpu ref upd/s", "gpu updates/s", "gpu/cpu"
+    );
     for (iterations, paper) in [(16u32, 600.0), (18, 180.0)] {
         let g =
             Grammar::parse("axiom: A(1)\nA(l) -> F(l)[+(30)A(l*0.8)][-(30)/(90)A(l*0.8)]\n", "binary.lsys").unwrap();
         let t = g.generate(&LSystemOptions { seed: 1, iterations: Some(iterations), ..Default::default() }).unwrap();
         let m = Skjermo::new(&t, SkjermoParams::default());
+        let n = t.stems.len();
+        // The CPU path: eight stems per lane group, buffers ping-pong.
+        let mut state = m.rest_state(&t);
+        let cpu = time(15, || m.step_stems(&fields, &waves, &mut state, 1.0 / 60.0));
+        // The reference kernel (one stem at a time; the WGSL's twin).
         let state = m.rest_state(&t);
         let mut next = state.stems.clone();
-        let n = t.stems.len();
-        let cpu = time(7, || {
+        let reference = time(5, || {
             sylva_core::cpu::skjermo::skjermo_step(
                 &fields,
                 &waves,
@@ -123,6 +132,7 @@ fn skjermo_table(ctx: Option<&'static GpuContext>, wind_name: &str, wind: WindSc
             );
         });
         let cpu_rate = 1.0 / cpu.as_secs_f64();
+        let ref_rate = 1.0 / reference.as_secs_f64();
         let gpu_rate = ctx.map(|c| {
             let mut g = sylva_gpu::pose::GpuSkjermo::new(c, &t, &m, &wind).unwrap();
             let d = time(3, || {
@@ -134,8 +144,107 @@ fn skjermo_table(ctx: Option<&'static GpuContext>, wind_name: &str, wind: WindSc
             20.0 / d.as_secs_f64()
         });
         match gpu_rate {
-            Some(gr) => println!("{n:>9} {cpu_rate:>14.1} {gr:>14.1} {:>9.2}×   {paper} updates/s", gr / cpu_rate),
-            None => println!("{n:>9} {cpu_rate:>14.1} {:>14} {:>10}   {paper} updates/s", "–", "–"),
+            Some(gr) => println!(
+                "{n:>9} {cpu_rate:>14.1} {ref_rate:>14.1} {gr:>14.1} {:>9.2}×   {paper} updates/s",
+                gr / cpu_rate
+            ),
+            None => println!("{n:>9} {cpu_rate:>14.1} {ref_rate:>14.1} {:>14} {:>10}   {paper} updates/s", "–", "–"),
+        }
+    }
+}
+
+/// Forward kinematics on the GPU, the two ways to walk the hierarchy: every segment walks its
+/// ancestor chain (two dispatches) or one dispatch per depth, root first. 20 poses recorded
+/// into one submission, then waited for.
+fn fk_table(ctx: Option<&'static GpuContext>) {
+    use sylva_gpu::pose::{FkStrategy, GpuPose};
+    let Some(c) = ctx else { return };
+    println!("\nForward kinematics on the GPU (M segments/s; 20 poses per submission)");
+    println!(
+        "{:<16} {:>9} {:>6} {:>14} {:>14} {:>10}",
+        "tree", "segments", "depth", "ancestor walk", "by level", "walk/level"
+    );
+    for name in ["quaking_aspen", "black_tupelo", "weeping_willow", "sympodial"] {
+        let t = SpeciesSource::resolve(name).unwrap().generate(1, &Default::default(), None).unwrap();
+        let n = t.segments.len();
+        let depth = sylva_core::cpu::pose_fk::depth_buckets(&t.segments.parent).len();
+        let delta = vec![[0.0f32, 0.0, 0.0, 1.0]; n];
+        let rate = |strategy| {
+            let p = GpuPose::with_strategy(c, &t, strategy).unwrap();
+            c.queue.write_buffer(p.delta_buffer(), 0, bytemuck::cast_slice(&delta));
+            let d = time(7, || {
+                let mut e = c.device.create_command_encoder(&Default::default());
+                for _ in 0..20 {
+                    p.record(c, &mut e);
+                }
+                c.queue.submit([e.finish()]);
+                c.wait().unwrap();
+            });
+            n as f64 * 20.0 / d.as_secs_f64() / 1e6
+        };
+        let (walk, level) = (rate(FkStrategy::AncestorWalk), rate(FkStrategy::LevelByLevel));
+        println!("{name:<16} {n:>9} {depth:>6} {walk:>14.2} {level:>14.2} {:>9.2}×", walk / level);
+    }
+}
+
+/// Zioma's Table 6-1 sizes: 30, 100, 256 and 1,000 instances of an 80-branch tree (a trunk
+/// and 79 side branches of four segments), one pose per frame for every instance: CPU
+/// (rotations + forward kinematics, rayon) and GPU (one dispatch over all instances' segments
+/// and one forward-kinematics pass, waited for). The paper's figures (GeForce 8800 GTX)
+/// include skinning 4,617 vertices per instance, which is the meshing issue's path.
+fn zioma_instances_table(ctx: Option<&'static GpuContext>, wind: &WindScene) {
+    use sylva_core::animate::zioma::ZiomaInstance;
+    use sylva_core::{Grammar, LSystemOptions};
+    let g = Grammar::parse(
+        "axiom: !(0.3)T(79)\nT(n) : n > 0 -> F(0.15)[&(55)/(137.5*n)!(0.06)F(0.5)F(0.45)F(0.4)F(0.3)]T(n-1)\n",
+        "eighty.lsys",
+    )
+    .unwrap();
+    let t = g.generate(&LSystemOptions { seed: 1, iterations: Some(80), ..Default::default() }).unwrap();
+    assert_eq!(t.stems.len(), 80);
+    let z = Zioma::new(&t, ZiomaParams::default());
+    let (fields, waves) = wind.pack();
+    println!(
+        "\nZioma instancing (Table 6-1 sizes; {} branches, {} segments per instance), ms per frame",
+        t.stems.len(),
+        t.segments.len()
+    );
+    println!(
+        "{:>9} {:>9} {:>10} {:>10} {:>10}   paper DX10 (8800 GTX, with skinning)",
+        "instances", "branches", "cpu ms", "gpu ms", "gpu/cpu"
+    );
+    for (count, paper) in [(30usize, 1.34), (100, 3.82), (256, 9.68), (1000, 37.61)] {
+        let instances = ZiomaInstance::grid(count, 8.0, 1);
+        let mut tt = 0.0;
+        let cpu = time(9, || {
+            tt += 1.0 / 60.0;
+            let d = z.rotations_instances(&t, &fields, &waves, tt, &instances);
+            std::hint::black_box(sylva_core::animate::Pose::from_rotations_instances(&t, &d));
+        });
+        let gpu = ctx.map(|c| {
+            let g = GpuZioma::with_instances(c, &t, &z, wind, &instances).unwrap();
+            time(9, || {
+                tt += 1.0 / 60.0;
+                g.submit(c, &t, &z, tt);
+                c.wait().unwrap();
+            })
+        });
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        match gpu {
+            Some(gd) => println!(
+                "{count:>9} {:>9} {:>10.2} {:>10.2} {:>9.2}×   {paper} ms",
+                count * t.stems.len(),
+                ms(cpu),
+                ms(gd),
+                ms(cpu) / ms(gd)
+            ),
+            None => println!(
+                "{count:>9} {:>9} {:>10.2} {:>10} {:>10}   {paper} ms",
+                count * t.stems.len(),
+                ms(cpu),
+                "–",
+                "–"
+            ),
         }
     }
 }

@@ -2,44 +2,102 @@
 //! rotations, and Zioma's method producing those rotations on the GPU.
 
 use crate::kernel::{Kernel, output, read_back, upload};
-use crate::shader::{NOISE, POSE_ACCUMULATE, POSE_POSITIONS, QUAT, TREE, WIND, ZIOMA_ROTATIONS};
+use crate::shader::{NOISE, POSE_ACCUMULATE, POSE_LEVEL, POSE_POSITIONS, QUAT, TREE, WIND, ZIOMA_ROTATIONS};
 use crate::{GpuContext, GpuError};
 use glam::{Quat, Vec3};
 use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::animate::Pose;
-use sylva_core::animate::zioma::{RawZiomaFrame, Zioma};
+use sylva_core::animate::zioma::{RawZiomaFrame, Zioma, ZiomaInstance};
 use sylva_core::wind::WindScene;
 use sylva_core::wind::raw::{RawField, RawWave};
+
+/// How forward kinematics walks the hierarchy on the GPU.
+///
+/// Measured on every preset (`cargo bench -p sylva-gpu --bench animate`, figures in
+/// `docs/PERFORMANCE.md`): the ancestor walk is one pair of dispatches whatever the depth,
+/// and each invocation reads its chain (≤ depth quaternions, cached: siblings share them);
+/// level by level needs one dispatch per depth (37 for the weeping willow) with little work
+/// in each. The walk is the default.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FkStrategy {
+    /// Every segment walks its own ancestor chain (`pose_accumulate`, `pose_positions`).
+    #[default]
+    AncestorWalk,
+    /// One dispatch per depth, root first (`pose_level`).
+    LevelByLevel,
+}
 
 /// A tree uploaded once; poses computed on the GPU from rotations made there.
 #[derive(Debug)]
 pub struct GpuPose {
     accumulate: Arc<Kernel>,
     positions: Arc<Kernel>,
+    level: Arc<Kernel>,
+    strategy: FkStrategy,
+    levels: Vec<(wgpu::Buffer, u32)>,
+    disp: wgpu::Buffer,
     parents: wgpu::Buffer,
     rest: wgpu::Buffer,
     delta: wgpu::Buffer,
     acc: wgpu::Buffer,
     joints: wgpu::Buffer,
     n: usize,
+    instances: usize,
     rest_orientation: Vec<Quat>,
 }
 
 impl GpuPose {
-    /// Uploads the tree's hierarchy and rest joints.
+    /// Uploads the tree's hierarchy and rest joints (ancestor walks).
     pub fn new(ctx: &GpuContext, tree: &Tree) -> Result<Self, GpuError> {
+        Self::with_strategy(ctx, tree, FkStrategy::default())
+    }
+
+    /// Uploads the tree's hierarchy and rest joints, walking the hierarchy as `strategy` says.
+    pub fn with_strategy(ctx: &GpuContext, tree: &Tree, strategy: FkStrategy) -> Result<Self, GpuError> {
+        Self::build(ctx, tree, strategy, 1)
+    }
+
+    /// `count` instances of the tree (ancestor walks over instance-major buffers: a
+    /// method writes `instance × segments + segment`).
+    pub fn with_instances(ctx: &GpuContext, tree: &Tree, count: usize) -> Result<Self, GpuError> {
+        Self::build(ctx, tree, FkStrategy::AncestorWalk, count.max(1))
+    }
+
+    fn build(ctx: &GpuContext, tree: &Tree, strategy: FkStrategy, instances: usize) -> Result<Self, GpuError> {
         let n = tree.segments.len();
+        let total = n * instances;
+        let levels = match strategy {
+            FkStrategy::AncestorWalk => Vec::new(),
+            FkStrategy::LevelByLevel => sylva_core::cpu::pose_fk::depth_buckets(&tree.segments.parent)
+                .into_iter()
+                .map(|b| {
+                    let len = b.len() as u32;
+                    let mut padded = b;
+                    padded.resize(padded.len().div_ceil(4) * 4, u32::MAX);
+                    Ok((upload(ctx, "fk level", &padded)?, len))
+                })
+                .collect::<Result<_, GpuError>>()?,
+        };
         let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
         Ok(Self {
             accumulate: Kernel::cached(ctx, "pose_accumulate", &[QUAT, TREE, POSE_ACCUMULATE]),
             positions: Kernel::cached(ctx, "pose_positions", &[QUAT, TREE, POSE_POSITIONS]),
+            level: Kernel::cached(ctx, "pose_level", &[QUAT, TREE, POSE_LEVEL]),
+            strategy,
+            levels,
+            disp: output::<[f32; 4]>(
+                ctx,
+                "fk displacements",
+                if strategy == FkStrategy::LevelByLevel { n } else { 1 },
+            )?,
             parents: upload(ctx, "parents", &tree.segments.parent)?,
             rest: upload(ctx, "rest joints", &rest)?,
-            delta: output::<[f32; 4]>(ctx, "delta", n)?,
-            acc: output::<[f32; 4]>(ctx, "acc", n)?,
-            joints: output::<[f32; 4]>(ctx, "joints", n)?,
+            delta: output::<[f32; 4]>(ctx, "delta", total)?,
+            acc: output::<[f32; 4]>(ctx, "acc", total)?,
+            joints: output::<[f32; 4]>(ctx, "joints", total)?,
             n,
+            instances,
             rest_orientation: tree.segments.orientation.clone(),
         })
     }
@@ -52,8 +110,23 @@ impl GpuPose {
     /// Runs forward kinematics on the rotations in [`Self::delta_buffer`] (recorded into
     /// `encoder`).
     pub fn record(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
-        self.accumulate.record(ctx, encoder, &[&self.parents, &self.delta, &self.acc], self.n as u32);
-        self.positions.record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, &self.joints], self.n as u32);
+        match self.strategy {
+            FkStrategy::AncestorWalk => {
+                let total = (self.n * self.instances) as u32;
+                self.accumulate.record(ctx, encoder, &[&self.parents, &self.delta, &self.acc], total);
+                self.positions.record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, &self.joints], total);
+            }
+            FkStrategy::LevelByLevel => {
+                for (bucket, len) in &self.levels {
+                    self.level.record(
+                        ctx,
+                        encoder,
+                        &[bucket, &self.parents, &self.rest, &self.delta, &self.acc, &self.disp, &self.joints],
+                        *len,
+                    );
+                }
+            }
+        }
     }
 
     /// Forward kinematics of given rotations, read back as a [`Pose`].
@@ -65,7 +138,7 @@ impl GpuPose {
         self.read(ctx)
     }
 
-    /// Reads the current pose back.
+    /// Reads the current pose back (the first instance).
     pub fn read(&self, ctx: &GpuContext) -> Result<Pose, GpuError> {
         let joints: Vec<[f32; 4]> = read_back(ctx, &self.joints, self.n)?;
         let acc: Vec<[f32; 4]> = read_back(ctx, &self.acc, self.n)?;
@@ -74,6 +147,22 @@ impl GpuPose {
             orientation: acc.iter().zip(&self.rest_orientation).map(|(d, q)| Quat::from_array(*d) * *q).collect(),
             bezier: None,
         })
+    }
+
+    /// Reads every instance's pose back.
+    pub fn read_all(&self, ctx: &GpuContext) -> Result<Vec<Pose>, GpuError> {
+        let total = self.n * self.instances;
+        let joints: Vec<[f32; 4]> = read_back(ctx, &self.joints, total)?;
+        let acc: Vec<[f32; 4]> = read_back(ctx, &self.acc, total)?;
+        Ok(joints
+            .chunks(self.n.max(1))
+            .zip(acc.chunks(self.n.max(1)))
+            .map(|(j, a)| Pose {
+                start: j.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect(),
+                orientation: a.iter().zip(&self.rest_orientation).map(|(d, q)| Quat::from_array(*d) * *q).collect(),
+                bezier: None,
+            })
+            .collect())
     }
 }
 
@@ -89,39 +178,72 @@ pub struct GpuZioma {
     stems: wgpu::Buffer,
     frame: wgpu::Buffer,
     packed: (Vec<RawField>, Vec<RawWave>),
+    instances: Vec<ZiomaInstance>,
 }
 
 impl GpuZioma {
     /// Uploads the tree, Zioma's per-stem constants and the wind scene.
     pub fn new(ctx: &GpuContext, tree: &Tree, method: &Zioma, wind: &WindScene) -> Result<Self, GpuError> {
+        Self::with_instances(ctx, tree, method, wind, &[])
+    }
+
+    /// Many placed instances of the tree (§6.5 instancing): one dispatch for every
+    /// (instance, segment) and one forward-kinematics pass over them all per frame. An empty
+    /// list is the single tree at the origin.
+    pub fn with_instances(
+        ctx: &GpuContext,
+        tree: &Tree,
+        method: &Zioma,
+        wind: &WindScene,
+        instances: &[ZiomaInstance],
+    ) -> Result<Self, GpuError> {
         let (fields, waves) = wind.pack();
+        let count = instances.len().max(1);
         let (wind_fields, wind_waves) = crate::wind_sample::upload_wind(ctx, &fields, &waves)?;
         Ok(Self {
             kernel: Kernel::cached(ctx, "zioma_rotations", &[QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS]),
-            pose: GpuPose::new(ctx, tree)?,
+            pose: GpuPose::with_instances(ctx, tree, count)?,
             fields: wind_fields,
             waves: wind_waves,
             segments: upload(ctx, "segments", &tree.raw_segments())?,
             stems: upload(ctx, "zioma stems", &method.stems)?,
-            frame: upload(ctx, "zioma frame", &[RawZiomaFrame::default_zeroed()])?,
+            frame: upload(ctx, "zioma frames", &vec![RawZiomaFrame::default_zeroed(); count])?,
             packed: (fields, waves),
+            instances: instances.to_vec(),
         })
     }
 
-    /// The pose at time `t`: the per-tree frame values are computed on the CPU (one wind
-    /// sample and the trunk bands), everything per segment on the GPU.
-    pub fn pose(&self, ctx: &GpuContext, tree: &Tree, method: &Zioma, t: f32) -> Result<Pose, GpuError> {
-        let frame = method.frame(tree, &self.packed.0, &self.packed.1, t);
-        ctx.queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame));
+    /// Records and submits every instance's pose at time `t` without reading it back (the
+    /// per-instance frame values are computed on the CPU: one wind sample and the trunk
+    /// bands each).
+    pub fn submit(&self, ctx: &GpuContext, tree: &Tree, method: &Zioma, t: f32) {
+        let frames: Vec<RawZiomaFrame> = if self.instances.is_empty() {
+            vec![method.frame(tree, &self.packed.0, &self.packed.1, t)]
+        } else {
+            self.instances.iter().map(|i| method.frame_for(tree, &self.packed.0, &self.packed.1, t, Some(i))).collect()
+        };
+        ctx.queue.write_buffer(&self.frame, 0, bytemuck::cast_slice(&frames));
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         self.kernel.record(
             ctx,
             &mut encoder,
             &[&self.fields, &self.waves, &self.segments, &self.stems, &self.frame, self.pose.delta_buffer()],
-            self.pose.n as u32,
+            (self.pose.n * self.pose.instances) as u32,
         );
         self.pose.record(ctx, &mut encoder);
         ctx.queue.submit([encoder.finish()]);
+    }
+
+    /// Every instance's pose at time `t`.
+    pub fn poses(&self, ctx: &GpuContext, tree: &Tree, method: &Zioma, t: f32) -> Result<Vec<Pose>, GpuError> {
+        self.submit(ctx, tree, method, t);
+        self.pose.read_all(ctx)
+    }
+
+    /// The pose at time `t`: the per-tree frame values are computed on the CPU (one wind
+    /// sample and the trunk bands), everything per segment on the GPU.
+    pub fn pose(&self, ctx: &GpuContext, tree: &Tree, method: &Zioma, t: f32) -> Result<Pose, GpuError> {
+        self.submit(ctx, tree, method, t);
         self.pose.read(ctx)
     }
 }

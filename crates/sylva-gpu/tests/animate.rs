@@ -9,7 +9,7 @@ use sylva_core::animate::Pose;
 use sylva_core::animate::zioma::{Zioma, ZiomaParams};
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
-use sylva_gpu::pose::{GpuPose, GpuZioma};
+use sylva_gpu::pose::{FkStrategy, GpuPose, GpuZioma};
 
 /// Joint positions agree within 1e-4 × tree height (the bound); orientations within
 /// 1e-4 rad. Both sides walk the same ancestor chains with the same f32 operations.
@@ -47,6 +47,39 @@ fn forward_kinematics_matches_on_random_rotations() {
         let gpu = GpuPose::new(ctx, &t).unwrap().pose_from_rotations(ctx, &delta).unwrap();
         let worst = compare(&t, &cpu, &gpu, name);
         println!("fk {name}: worst joint difference {worst:.2e} × height");
+        // The level-by-level alternative: the same pose to rounding (it multiplies and sums
+        // root first rather than leaf first), and its CPU twin likewise.
+        let level = GpuPose::with_strategy(ctx, &t, FkStrategy::LevelByLevel).unwrap();
+        let gpu = level.pose_from_rotations(ctx, &delta).unwrap();
+        let worst = compare(&t, &cpu, &gpu, &format!("{name} level by level"));
+        println!("fk {name} level by level: worst joint difference {worst:.2e} × height");
+        let n = t.segments.len();
+        let rest: Vec<[f32; 4]> = t.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
+        let (mut acc, mut disp, mut joints) = (vec![[0.0f32; 4]; n], vec![[0.0f32; 4]; n], vec![[0.0f32; 4]; n]);
+        for b in sylva_core::cpu::pose_fk::depth_buckets(&t.segments.parent) {
+            sylva_core::cpu::pose_fk::pose_level(
+                &b,
+                &t.segments.parent,
+                &rest,
+                &delta,
+                &mut acc,
+                &mut disp,
+                &mut joints,
+            );
+        }
+        let twin = Pose {
+            start: joints.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect(),
+            orientation: acc.iter().zip(&t.segments.orientation).map(|(d, q)| Quat::from_array(*d) * *q).collect(),
+            bezier: None,
+        };
+        compare(&t, &twin, &gpu, &format!("{name} level-by-level twin"));
+    }
+    // Identity rotations give the rest pose exactly either way.
+    let t = SpeciesSource::resolve("quaking_aspen").unwrap().generate(1, &Default::default(), None).unwrap();
+    let identity = vec![[0.0f32, 0.0, 0.0, 1.0]; t.segments.len()];
+    for strategy in [FkStrategy::AncestorWalk, FkStrategy::LevelByLevel] {
+        let gpu = GpuPose::with_strategy(ctx, &t, strategy).unwrap().pose_from_rotations(ctx, &identity).unwrap();
+        assert_eq!(gpu.start, t.segments.start, "{strategy:?}");
     }
 }
 
@@ -77,4 +110,34 @@ fn zioma_on_the_gpu_is_at_rest_in_still_air() {
     let z = Zioma::new(&t, ZiomaParams::default());
     let gpu = GpuZioma::new(ctx, &t, &z, &WindScene::default()).unwrap();
     assert_eq!(gpu.pose(ctx, &t, &z, 5.0).unwrap(), Pose::rest(&t));
+}
+
+/// Instancing (§6.5): many placed, turned, phase-shifted copies of one tree in one dispatch.
+/// GPU vs CPU per instance within 1e-4 × height; an instance at the origin, unturned, with no
+/// phase or seed reproduces the single tree exactly; instances at different places differ.
+#[test]
+fn zioma_instances_match_and_sway_independently() {
+    use sylva_core::animate::zioma::ZiomaInstance;
+    let Some(ctx) = common::gpu() else { return };
+    let wind = WindScene::resolve("gusty").unwrap();
+    let (f, w) = wind.pack();
+    let t = SpeciesSource::resolve("stochastic_bush").unwrap().generate(4, &Default::default(), None).unwrap();
+    let z = Zioma::new(&t, ZiomaParams::default());
+    let mut instances = ZiomaInstance::grid(37, 6.0, 9);
+    instances[0] = ZiomaInstance::default();
+    let gpu = GpuZioma::with_instances(ctx, &t, &z, &wind, &instances).unwrap();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(13);
+    for _ in 0..3 {
+        let time = rng.random_range(0.0..60.0);
+        let cpu = Pose::from_rotations_instances(&t, &z.rotations_instances(&t, &f, &w, time, &instances));
+        let got = gpu.poses(ctx, &t, &z, time).unwrap();
+        assert_eq!(cpu.len(), instances.len());
+        assert_eq!(got.len(), instances.len());
+        for (k, (a, b)) in cpu.iter().zip(&got).enumerate() {
+            compare(&t, a, b, &format!("instance {k} at {time} s"));
+        }
+        assert_eq!(cpu[0], z.pose(&t, &wind, time), "an instance at the origin is the single tree");
+        let distinct = cpu.windows(2).filter(|p| p[0].start != p[1].start).count();
+        assert!(distinct >= instances.len() - 2, "instances sway alike: {distinct} differ");
+    }
 }

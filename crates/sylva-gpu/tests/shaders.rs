@@ -208,6 +208,10 @@ fn animation_structs_match_their_wgsl_twins() {
             ("amplitude", offset_of!(RawZiomaFrame, amplitude)),
             ("max_bend", offset_of!(RawZiomaFrame, max_bend)),
             ("inertia", offset_of!(RawZiomaFrame, inertia)),
+            ("origin", offset_of!(RawZiomaFrame, origin)),
+            ("phase", offset_of!(RawZiomaFrame, phase)),
+            ("heading", offset_of!(RawZiomaFrame, heading)),
+            ("_pad", offset_of!(RawZiomaFrame, _pad)),
         ],
     );
     check_in(

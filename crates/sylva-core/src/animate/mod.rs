@@ -21,6 +21,7 @@
 
 pub mod akagi;
 pub mod skjermo;
+pub mod skjermo_lanes;
 pub mod zioma;
 
 use crate::model::Tree;
@@ -73,6 +74,25 @@ impl Pose {
             }
         }
         Ok(())
+    }
+
+    /// Poses of many instances of one tree from their rotations, instance-major
+    /// (`instance × segments + segment`), in one parallel forward-kinematics pass.
+    pub fn from_rotations_instances(tree: &Tree, delta: &[[f32; 4]]) -> Vec<Self> {
+        let n = tree.segments.len();
+        let mut acc = vec![[0.0f32; 4]; delta.len()];
+        crate::cpu::pose_fk::pose_accumulate(&tree.segments.parent, delta, &mut acc);
+        let mut out = vec![[0.0f32; 4]; delta.len()];
+        let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
+        crate::cpu::pose_fk::pose_positions(&tree.segments.parent, &rest, &acc, &mut out);
+        out.chunks(n.max(1))
+            .zip(acc.chunks(n.max(1)))
+            .map(|(j, a)| Self {
+                start: j.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect(),
+                orientation: a.iter().zip(&tree.segments.orientation).map(|(d, q)| Quat::from_array(*d) * *q).collect(),
+                bezier: None,
+            })
+            .collect()
     }
 
     /// Pose from per-segment rotations `δ` (x, y, z, w), by forward kinematics.

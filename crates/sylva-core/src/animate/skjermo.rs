@@ -25,11 +25,13 @@
 //! carries the animated curves for the deformer.
 
 use super::Pose;
+use super::skjermo_lanes::{self, LANES, LaneStep, StateLanes, StemLanes};
 use crate::cpu::skjermo::{skjermo_rotations, skjermo_step};
 use crate::model::{NONE, Tree};
 use crate::wind::raw::{RawField, RawWave};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
+use rayon::prelude::*;
 
 /// Parameters of Skjermo's method.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -103,12 +105,15 @@ pub struct RawSkjermoStep {
 pub struct Skjermo {
     /// Parameters.
     pub params: SkjermoParams,
-    /// Per-stem constants.
+    /// Per-stem constants (after editing them, call [`Skjermo::rebuild_lanes`]).
     pub stems: Vec<RawSkjermoStem>,
     /// Rest orientation vector of each stem.
     pub rest_orient: Vec<[f32; 4]>,
     /// Per-segment (stem, Bézier parameter of the segment's middle).
     pub segment_param: Vec<[f32; 4]>,
+    /// The per-stem constants in groups of eight for the fast CPU step.
+    pub lanes: Vec<StemLanes>,
+    rest_lanes: Vec<StateLanes>,
 }
 
 /// State: per-stem displacements (current), time and the current pose.
@@ -122,6 +127,10 @@ pub struct SkjermoState {
     pub time: f32,
     /// Current pose (with Béziers).
     pub pose: Pose,
+    /// The per-stem state in groups of eight (what the CPU step reads and writes; `stems`
+    /// is copied from it after every step).
+    pub lanes: Vec<StateLanes>,
+    scratch: Vec<StateLanes>,
 }
 
 /// Bézier point.
@@ -136,13 +145,23 @@ pub fn bezier_d(p: &[Vec3; 4], t: f32) -> Vec3 {
     (p[1] - p[0]) * (3.0 * s * s) + (p[2] - p[1]) * (6.0 * s * t) + (p[3] - p[2]) * (3.0 * t * t)
 }
 
+/// `v` normalised (by one reciprocal) where longer than 1e-6, else `fallback`. WGSL:
+/// `unit_or` in `skjermo.wgsl`; the lane path (`skjermo_lanes`) rounds the same way, so the
+/// rest frames it stores match these bit for bit.
+pub fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
+    let l = v.length();
+    if l > 1e-6 { v * (1.0 / l) } else { fallback }
+}
+
 /// The attachment frame `[T, N, B]` at `t` with orientation vector `o` (columns as arrays).
 pub fn frame(p: &[Vec3; 4], o: Vec3, t: f32) -> [Vec3; 3] {
-    let tan = crate::cpu::zioma_rotations::axis_or(bezier_d(p, t), Vec3::Y);
-    let n = crate::cpu::zioma_rotations::axis_or(
-        o - tan * o.dot(tan),
-        crate::cpu::zioma_rotations::axis_or(tan.any_orthogonal_vector(), Vec3::X),
-    );
+    frame_from_tangent(bezier_d(p, t), o)
+}
+
+/// The attachment frame from a curve tangent (not necessarily unit) and an orientation vector.
+pub fn frame_from_tangent(tangent: Vec3, o: Vec3) -> [Vec3; 3] {
+    let tan = unit_or(tangent, Vec3::Y);
+    let n = unit_or(o - tan * o.dot(tan), unit_or(tan.any_orthogonal_vector(), Vec3::X));
     [tan, n, tan.cross(n)]
 }
 
@@ -204,7 +223,13 @@ impl Skjermo {
                 [f32::from_bits(k as u32), closest_param(&ctrl(k), mid), 0.0, 0.0]
             })
             .collect();
-        Self { params, stems, rest_orient, segment_param }
+        let (lanes, rest_lanes) = skjermo_lanes::build(&stems, &rest_orient);
+        Self { params, stems, rest_orient, segment_param, lanes, rest_lanes }
+    }
+
+    /// Rebuilds the fast path's lane groups from `stems` (after editing them).
+    pub fn rebuild_lanes(&mut self) {
+        (self.lanes, self.rest_lanes) = skjermo_lanes::build(&self.stems, &self.rest_orient);
     }
 
     /// The state at rest.
@@ -214,6 +239,8 @@ impl Skjermo {
             steps: 0,
             time: 0.0,
             pose: Pose { bezier: Some(tree.stems.bezier.clone()), ..Pose::rest(tree) },
+            lanes: self.rest_lanes.clone(),
+            scratch: self.rest_lanes.clone(),
         }
     }
 
@@ -228,15 +255,52 @@ impl Skjermo {
         }
     }
 
-    /// Advances one step of `dt` seconds: all stems re-attach to their parents' previous
-    /// curves and bend (ping-pong), then the pose follows.
-    pub fn step(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
+    /// Per-step values of the fast CPU step.
+    pub fn lane_step(&self, time: f32) -> LaneStep {
+        LaneStep { time, p2_factor: self.params.p2_weight.powf(self.params.exponent), max_bend: self.params.max_bend }
+    }
+
+    /// Advances only the stems' curves one step of `dt` seconds (no pose): every stem
+    /// re-attaches to its parent's previous curve and bends; the two lane buffers ping-pong.
+    /// This is the branch update Skjermo's figures count.
+    pub fn step_stems(&self, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
+        let t = state.time + dt;
+        skjermo_lanes::step(fields, waves, &self.lanes, &state.lanes, self.lane_step(t), &mut state.scratch);
+        std::mem::swap(&mut state.lanes, &mut state.scratch);
+        state.time = t;
+        state.steps += 1;
+    }
+
+    /// The same step through the reference kernel (`cpu::skjermo::skjermo_step`, the twin of
+    /// the WGSL), one stem at a time, on `state.stems` only; kept to check the fast path
+    /// against.
+    pub fn step_reference(&self, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
         let t = state.time + dt;
         let mut next = state.stems.clone();
         skjermo_step(fields, waves, &self.stems, &state.stems, self.step_params(t), &mut next);
         state.stems = next;
         state.time = t;
         state.steps += 1;
+    }
+
+    /// Advances one step of `dt` seconds: all stems re-attach to their parents' previous
+    /// curves and bend (ping-pong, eight stems at a time), then the pose follows.
+    pub fn step(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
+        self.step_stems(fields, waves, state, dt);
+        let lanes = &state.lanes;
+        state.stems.par_iter_mut().enumerate().for_each(|(k, s)| {
+            let g = &lanes[k / LANES];
+            let l = k % LANES;
+            *s = RawSkjermoState {
+                delta: [0, 1, 2, 3].map(|j| g.delta(l, j).extend(0.0).to_array()),
+                orient: g.orient(l).extend(0.0).to_array(),
+            };
+        });
+        self.update_pose(tree, state);
+    }
+
+    /// The pose (segment transforms and animated Béziers) from `state.stems`.
+    pub fn update_pose(&self, tree: &Tree, state: &mut SkjermoState) {
         let mut delta = vec![[0.0f32; 4]; tree.segments.len()];
         skjermo_rotations(&self.segment_param, &self.stems, &state.stems, &tree.segments.parent, &mut delta);
         let mut pose = Pose::from_rotations(tree, &delta);

@@ -93,7 +93,9 @@ pub struct RawZiomaStem {
     pub _pad: u32,
 }
 
-/// Per-frame, per-tree values, 48 bytes. WGSL: `ZiomaFrame`.
+/// Per-frame, per-instance values, 80 bytes. WGSL: `ZiomaFrame`. Directions are in the
+/// tree's own frame; `origin` and `heading` place the instance in the world, where the wind
+/// is sampled.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawZiomaFrame {
@@ -113,6 +115,64 @@ pub struct RawZiomaFrame {
     pub max_bend: f32,
     /// Inertia gain.
     pub inertia: f32,
+    /// Instance position in the world, m.
+    pub origin: [f32; 3],
+    /// Instance phase offset, cycles (added to every branch's phase).
+    pub phase: f32,
+    /// Instance heading (cos, sin of the yaw about +Y).
+    pub heading: [f32; 2],
+    /// Padding.
+    pub _pad: [f32; 2],
+}
+
+/// One placed copy of a tree (instancing, §6.5): position, yaw, its own phase and seed, so
+/// a forest of one species does not sway in lockstep.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ZiomaInstance {
+    /// Position of the tree's origin in the world, m.
+    pub position: Vec3,
+    /// Rotation about +Y, rad.
+    pub yaw: f32,
+    /// Phase offset of every branch, cycles.
+    pub phase: f32,
+    /// Seed of the trunk's noise for this instance.
+    pub seed: u32,
+}
+
+impl ZiomaInstance {
+    /// A seeded random placement on a square of side `spacing · ⌈√count⌉` (instance `k` of a
+    /// forest).
+    pub fn grid(count: usize, spacing: f32, seed: u64) -> Vec<Self> {
+        let side = (count as f32).sqrt().ceil().max(1.0) as usize;
+        (0..count)
+            .map(|k| {
+                let h = child_key(mix64(seed ^ 0x1A57), k as u64);
+                let u = |shift: u32| ((h >> shift) & 0xFFFF) as f32 / 65_536.0;
+                Self {
+                    position: Vec3::new(
+                        ((k % side) as f32 + 0.5 * u(0)) * spacing,
+                        0.0,
+                        ((k / side) as f32 + 0.5 * u(16)) * spacing,
+                    ),
+                    yaw: std::f32::consts::TAU * u(32),
+                    phase: u(48),
+                    seed: (h >> 8) as u32,
+                }
+            })
+            .collect()
+    }
+
+    /// World → tree frame for a horizontal vector (inverse yaw).
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        let (s, c) = self.yaw.sin_cos();
+        Vec3::new(c * v.x - s * v.z, v.y, s * v.x + c * v.z)
+    }
+
+    /// Tree frame → world for a point.
+    pub fn to_world(&self, p: Vec3) -> Vec3 {
+        let (s, c) = self.yaw.sin_cos();
+        self.position + Vec3::new(c * p.x + s * p.z, p.y, -s * p.x + c * p.z)
+    }
 }
 
 /// Zioma's method set up for one tree.
@@ -182,16 +242,35 @@ impl Zioma {
         Self { params, stems, crown_centre, tree_seed: mix64(params.seed) as u32, raw: tree.raw_segments() }
     }
 
-    /// The per-frame values at time `t`: wind at the crown, trunk angles and their rate.
+    /// The per-frame values at time `t`: wind at the crown, trunk angles and their rate (the
+    /// tree at the origin, unturned).
     pub fn frame(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], t: f32) -> RawZiomaFrame {
-        let v = crate::cpu::wind_sample::wind_at(fields, waves, self.crown_centre, t);
+        self.frame_for(tree, fields, waves, t, None)
+    }
+
+    /// The per-frame values of one instance (`None`: the tree at the origin, unturned).
+    pub fn frame_for(
+        &self,
+        tree: &Tree,
+        fields: &[RawField],
+        waves: &[RawWave],
+        t: f32,
+        instance: Option<&ZiomaInstance>,
+    ) -> RawZiomaFrame {
+        let (centre, seed) = match instance {
+            Some(i) => (i.to_world(self.crown_centre), self.tree_seed ^ i.seed),
+            None => (self.crown_centre, self.tree_seed),
+        };
+        let v = crate::cpu::wind_sample::wind_at(fields, waves, centre, t);
+        let v = instance.map_or(v, |i| i.to_local(v));
         let h = Vec3::new(v.x, 0.0, v.z);
         let u = h.length();
         let dir = if u > 1e-6 { h / u } else { Vec3::ZERO };
         let noise = TrunkNoise::for_tree(tree, u);
-        let a = noise.angles(t, self.tree_seed);
+        let a = noise.angles(t, seed);
         let dt = 0.01;
-        let rate = (noise.angles(t + dt, self.tree_seed)[0] - noise.angles(t - dt, self.tree_seed)[0]) / (2.0 * dt);
+        let rate = (noise.angles(t + dt, seed)[0] - noise.angles(t - dt, seed)[0]) / (2.0 * dt);
+        let (sin, cos) = instance.map_or((0.0, 1.0), |i| i.yaw.sin_cos());
         RawZiomaFrame {
             wind_dir: dir.to_array(),
             time: t,
@@ -201,7 +280,28 @@ impl Zioma {
             amplitude: self.params.amplitude,
             max_bend: self.params.max_bend,
             inertia: self.params.inertia,
+            origin: instance.map_or([0.0; 3], |i| i.position.to_array()),
+            phase: instance.map_or(0.0, |i| i.phase),
+            heading: [cos, sin],
+            _pad: [0.0; 2],
         }
+    }
+
+    /// Per-segment rotations δ of every instance at time `t`, instance by instance
+    /// (`instances.len() × segments`), all in one parallel pass (CPU reference).
+    pub fn rotations_instances(
+        &self,
+        tree: &Tree,
+        fields: &[RawField],
+        waves: &[RawWave],
+        t: f32,
+        instances: &[ZiomaInstance],
+    ) -> Vec<[f32; 4]> {
+        let frames: Vec<RawZiomaFrame> =
+            instances.iter().map(|i| self.frame_for(tree, fields, waves, t, Some(i))).collect();
+        let mut out = vec![[0.0; 4]; tree.segments.len() * instances.len()];
+        zioma_rotations(fields, waves, &self.raw, &self.stems, &frames, &mut out);
+        out
     }
 
     /// Per-segment rotations δ at time `t` (CPU reference).
@@ -214,7 +314,7 @@ impl Zioma {
     pub fn rotations_packed(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], t: f32) -> Vec<[f32; 4]> {
         let frame = self.frame(tree, fields, waves, t);
         let mut out = vec![[0.0; 4]; tree.segments.len()];
-        zioma_rotations(fields, waves, &self.raw, &self.stems, &frame, &mut out);
+        zioma_rotations(fields, waves, &self.raw, &self.stems, &[frame], &mut out);
         out
     }
 

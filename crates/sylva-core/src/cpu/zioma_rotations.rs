@@ -1,6 +1,6 @@
 //! CPU twin of `shader/zioma_rotations.wgsl`: Zioma's per-segment rotations
 //! (see [`crate::animate::zioma`]). Bindings: 0 fields, 1 waves, 2 segments, 3 stems,
-//! 4 frame, 5 δ.
+//! 4 frames (one per instance), 5 δ (instance-major: `instance × segments + segment`).
 
 use crate::animate::zioma::{RawZiomaFrame, RawZiomaStem};
 use crate::cpu::noise::value_noise;
@@ -38,8 +38,12 @@ pub fn zioma_rotation(
     if f.lod == 0 {
         return Quat::IDENTITY;
     }
-    let base = Vec3::from_array(stem.base);
-    let v = wind_at(fields, waves, base, f.time);
+    // The wind at the stem's base in the world, turned into the tree's frame.
+    let b = Vec3::from_array(stem.base);
+    let (hc, hs) = (f.heading[0], f.heading[1]);
+    let world = Vec3::from_array(f.origin) + Vec3::new(hc * b.x + hs * b.z, b.y, -hs * b.x + hc * b.z);
+    let vw = wind_at(fields, waves, world, f.time);
+    let v = Vec3::new(hc * vw.x - hs * vw.z, vw.y, hs * vw.x + hc * vw.z);
     let vh = Vec3::new(v.x, 0.0, v.z);
     let u = vh.length();
     if u < 1e-6 {
@@ -54,8 +58,9 @@ pub fn zioma_rotation(
     let back = c.max(0.0);
     let perp = 1.0 - c.abs();
     let theta = (stem.drag * u * u).min(f.max_bend) * f.amplitude;
-    let osc = value_noise(stem.freq * f.time + stem.phase, stem.seed);
-    let osc2 = value_noise(2.7 * stem.freq * f.time + stem.phase, stem.seed ^ 0x55);
+    let phase = stem.phase + f.phase;
+    let osc = value_noise(stem.freq * f.time + phase, stem.seed);
+    let osc2 = value_noise(2.7 * stem.freq * f.time + phase, stem.seed ^ 0x55);
     let inertia = -f.inertia * f.trunk_rate / (std::f32::consts::TAU * stem.freq);
     let bend = theta * (facing * (0.9 + 0.1 * osc) + back * (0.4 + 0.8 * osc) + perp * (0.6 + 0.3 * osc))
         + inertia * f.amplitude;
@@ -74,10 +79,12 @@ pub fn zioma_rotations(
     waves: &[RawWave],
     segments: &[RawSegment],
     stems: &[RawZiomaStem],
-    frame: &RawZiomaFrame,
+    frames: &[RawZiomaFrame],
     out: &mut [[f32; 4]],
 ) {
-    out.par_iter_mut().zip(segments.par_iter()).for_each(|(o, s)| {
-        *o = zioma_rotation(fields, waves, s, &stems[s.stem as usize], frame).to_array();
+    let n = segments.len();
+    out.par_iter_mut().enumerate().with_min_len(64).for_each(|(i, o)| {
+        let s = &segments[i % n];
+        *o = zioma_rotation(fields, waves, s, &stems[s.stem as usize], &frames[i / n]).to_array();
     });
 }

@@ -17,6 +17,8 @@ pub const WIND_SAMPLE: &str = include_str!("wind_sample.wgsl");
 pub const POSE_ACCUMULATE: &str = include_str!("pose_accumulate.wgsl");
 /// Kernel: posed joint positions by ancestor walk (the pose seam).
 pub const POSE_POSITIONS: &str = include_str!("pose_positions.wgsl");
+/// Kernel: one depth of forward kinematics, root first (the level-by-level alternative).
+pub const POSE_LEVEL: &str = include_str!("pose_level.wgsl");
 /// Kernel: Zioma's per-segment rotations.
 pub const ZIOMA_ROTATIONS: &str = include_str!("zioma_rotations.wgsl");
 /// Akagi's shared structs (`AkagiSegment`, `AkagiStep`).
@@ -43,6 +45,7 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("trunk_noise", &[NOISE, TRUNK_NOISE]),
     ("pose_accumulate", &[QUAT, TREE, POSE_ACCUMULATE]),
     ("pose_positions", &[QUAT, TREE, POSE_POSITIONS]),
+    ("pose_level", &[QUAT, TREE, POSE_LEVEL]),
     ("zioma_rotations", &[QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS]),
     ("akagi_forces", &[QUAT, TREE, NOISE, WIND, AKAGI, AKAGI_FORCES]),
     ("akagi_subtree", &[AKAGI_SUBTREE]),

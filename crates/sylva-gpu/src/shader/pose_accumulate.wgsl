@@ -1,6 +1,8 @@
 // pose_accumulate: acc[i] = delta[root] * ... * delta[parent] * delta[i], by walking the
 // ancestor chain (parents have smaller indices, so the walk takes at most i + 1 steps).
-// CPU twin: sylva_core::cpu::pose_fk::pose_accumulate (bindings 0 parents, 1 delta, 2 acc).
+// Instances: delta and acc hold instance-major copies (instance × segments + segment) of
+// one tree's hierarchy. CPU twin: sylva_core::cpu::pose_fk::pose_accumulate (bindings
+// 0 parents, 1 delta, 2 acc).
 
 @group(0) @binding(0) var<storage, read> parents: array<u32>;
 @group(0) @binding(1) var<storage, read> delta: array<vec4<f32>>;
@@ -12,10 +14,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if (i >= arrayLength(&delta)) {
         return;
     }
+    let n = arrayLength(&parents);
+    let base = (i / n) * n;
+    let l = i - base;
     var d = delta[i];
-    var a = parents[i];
-    for (var step = 0u; step <= i && a != NONE; step++) {
-        d = quat_mul(delta[a], d);
+    var a = parents[l];
+    for (var step = 0u; step <= l && a != NONE; step++) {
+        d = quat_mul(delta[base + a], d);
         a = parents[a];
     }
     acc[i] = d;

@@ -42,7 +42,7 @@ fn bezier_d(c: Curve, t: f32) -> vec3<f32> {
 fn unit_or(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
     let l = length(v);
     if (l > 1e-6) {
-        return v / l;
+        return v * (1.0 / l);
     }
     return fallback;
 }

@@ -1,6 +1,6 @@
 // zioma_rotations: Zioma's per-segment rotations. CPU twin:
 // sylva_core::cpu::zioma_rotations (bindings 0 fields, 1 waves — from wind.wgsl —
-// 2 segments, 3 stems, 4 frame, 5 delta).
+// 2 segments, 3 stems, 4 frames (one per instance), 5 delta, instance-major).
 
 struct ZiomaStem {
     base: vec3<f32>,
@@ -24,11 +24,15 @@ struct ZiomaFrame {
     amplitude: f32,
     max_bend: f32,
     inertia: f32,
+    origin: vec3<f32>,
+    phase: f32,
+    heading: vec2<f32>,
+    _pad: vec2<f32>,
 }
 
 @group(0) @binding(2) var<storage, read> segments: array<Segment>;
 @group(0) @binding(3) var<storage, read> stems: array<ZiomaStem>;
-@group(0) @binding(4) var<storage, read> frame: ZiomaFrame;
+@group(0) @binding(4) var<storage, read> frames: array<ZiomaFrame>;
 @group(0) @binding(5) var<storage, read_write> delta: array<vec4<f32>>;
 
 fn axis_or(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
@@ -56,7 +60,13 @@ fn zioma_rotation(s: Segment, stem: ZiomaStem, f: ZiomaFrame) -> vec4<f32> {
     if (f.lod == 0u) {
         return IDENTITY;
     }
-    let v = wind_at(stem.base, f.time);
+    // The wind at the stem's base in the world, turned into the tree's frame.
+    let b = stem.base;
+    let hc = f.heading.x;
+    let hs = f.heading.y;
+    let world = f.origin + vec3<f32>(hc * b.x + hs * b.z, b.y, -hs * b.x + hc * b.z);
+    let vw = wind_at(world, f.time);
+    let v = vec3<f32>(hc * vw.x - hs * vw.z, vw.y, hs * vw.x + hc * vw.z);
     let vh = vec3<f32>(v.x, 0.0, v.z);
     let u = length(vh);
     if (u < 1e-6) {
@@ -74,8 +84,9 @@ fn zioma_rotation(s: Segment, stem: ZiomaStem, f: ZiomaFrame) -> vec4<f32> {
     let back = max(c, 0.0);
     let perp = 1.0 - abs(c);
     let theta = min(stem.drag * u * u, f.max_bend) * f.amplitude;
-    let osc = value_noise(stem.freq * f.time + stem.phase, stem.seed);
-    let osc2 = value_noise(2.7 * stem.freq * f.time + stem.phase, stem.seed ^ 0x55u);
+    let phase = stem.phase + f.phase;
+    let osc = value_noise(stem.freq * f.time + phase, stem.seed);
+    let osc2 = value_noise(2.7 * stem.freq * f.time + phase, stem.seed ^ 0x55u);
     let inertia = -f.inertia * f.trunk_rate / (TAU * stem.freq);
     let bend = theta * (facing * (0.9 + 0.1 * osc) + back * (0.4 + 0.8 * osc) + perp * (0.6 + 0.3 * osc)) + inertia * f.amplitude;
     let k = axis_or(cross(dir, w), axis_or(cross(up, w), vec3<f32>(1.0, 0.0, 0.0)));
@@ -94,9 +105,10 @@ fn zioma_rotation(s: Segment, stem: ZiomaStem, f: ZiomaFrame) -> vec4<f32> {
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
-    if (i >= arrayLength(&segments)) {
+    if (i >= arrayLength(&delta)) {
         return;
     }
-    let s = segments[i];
-    delta[i] = zioma_rotation(s, stems[s.stem], frame);
+    let n = arrayLength(&segments);
+    let s = segments[i % n];
+    delta[i] = zioma_rotation(s, stems[s.stem], frames[i / n]);
 }
