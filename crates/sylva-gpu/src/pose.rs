@@ -28,6 +28,23 @@ pub enum FkStrategy {
     LevelByLevel,
 }
 
+/// Uploads depth buckets of segment indices, each padded with `u32::MAX` to a multiple of
+/// four entries (storage bindings are at least 16 bytes), with its unpadded length.
+fn upload_buckets(
+    ctx: &GpuContext,
+    label: &'static str,
+    buckets: &[Vec<u32>],
+) -> Result<Vec<(wgpu::Buffer, u32)>, GpuError> {
+    buckets
+        .iter()
+        .map(|b| {
+            let mut padded = b.clone();
+            padded.resize(b.len().div_ceil(4) * 4, u32::MAX);
+            Ok((upload(ctx, label, &padded)?, b.len() as u32))
+        })
+        .collect()
+}
+
 /// A tree uploaded once; poses computed on the GPU from rotations made there.
 #[derive(Debug)]
 pub struct GpuPose {
@@ -69,15 +86,9 @@ impl GpuPose {
         let total = n * instances;
         let levels = match strategy {
             FkStrategy::AncestorWalk => Vec::new(),
-            FkStrategy::LevelByLevel => sylva_core::cpu::pose_fk::depth_buckets(&tree.segments.parent)
-                .into_iter()
-                .map(|b| {
-                    let len = b.len() as u32;
-                    let mut padded = b;
-                    padded.resize(padded.len().div_ceil(4) * 4, u32::MAX);
-                    Ok((upload(ctx, "fk level", &padded)?, len))
-                })
-                .collect::<Result<_, GpuError>>()?,
+            FkStrategy::LevelByLevel => {
+                upload_buckets(ctx, "fk level", &sylva_core::cpu::pose_fk::depth_buckets(&tree.segments.parent))?
+            }
         };
         let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
         Ok(Self {
@@ -314,15 +325,7 @@ impl GpuAkagi {
             akagi: upload(ctx, "akagi segments", &method.segments)?,
             step: upload(ctx, "akagi step", &[method.step_params(0.0, 0.0)])?,
             method_step: method.step_params(0.0, 0.0),
-            buckets: method
-                .buckets
-                .iter()
-                .map(|b| {
-                    let mut padded = b.clone();
-                    padded.resize(b.len().div_ceil(4) * 4, u32::MAX);
-                    Ok((upload(ctx, "akagi bucket", &padded)?, b.len() as u32))
-                })
-                .collect::<Result<_, GpuError>>()?,
+            buckets: upload_buckets(ctx, "akagi bucket", &method.buckets)?,
             child_offset: upload(ctx, "child offsets", &c.offset)?,
             child_count: upload(ctx, "child counts", &c.count)?,
             child_index: upload(ctx, "child indices", &index)?,

@@ -22,7 +22,7 @@
 
 use super::Pose;
 use crate::cpu::akagi::{akagi_forces, akagi_integrate, akagi_subtree};
-use crate::model::{NONE, Tree};
+use crate::model::Tree;
 use crate::wind::WindScene;
 use crate::wind::raw::{RawField, RawWave};
 use bytemuck::{Pod, Zeroable};
@@ -184,17 +184,9 @@ impl Akagi {
                 }
             })
             .collect();
-        let mut depth = vec![0usize; n];
-        for i in 0..n {
-            if s.parent[i] != NONE {
-                depth[i] = depth[s.parent[i] as usize] + 1;
-            }
-        }
-        let max = depth.iter().copied().max().unwrap_or(0);
-        let mut buckets = vec![Vec::new(); max + 1];
-        for (i, d) in depth.iter().enumerate() {
-            buckets[max - d].push(i as u32);
-        }
+        // Deepest first: forces gather toward the root.
+        let mut buckets = crate::cpu::pose_fk::depth_buckets(&s.parent);
+        buckets.reverse();
         let rest = s.start.iter().map(|p| p.extend(0.0).to_array()).collect();
         Self { params, segments, buckets, raw: tree.raw_segments(), rest }
     }

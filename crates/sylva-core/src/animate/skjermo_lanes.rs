@@ -19,7 +19,7 @@
 //! reference to rounding (tested), and are identical whatever the thread count: every group is
 //! computed by the same instructions whichever thread runs it.
 
-use super::skjermo::RawSkjermoStem;
+use super::skjermo::{RawSkjermoStem, bezier_d};
 use crate::cpu::wind_sample::field_at;
 use crate::model::NONE;
 use crate::wind::raw::{RawField, RawWave, kind};
@@ -165,10 +165,6 @@ impl StateLanes {
     pub fn orient(&self, lane: usize) -> Vec3 {
         self.orient.lane(lane)
     }
-}
-
-fn bezier_d(p: &[Vec3; 4], t: f32) -> Vec3 {
-    super::skjermo::bezier_d(p, t)
 }
 
 /// Builds the lane groups from the reference's per-stem constants; `rest_orient` gives each
