@@ -7,6 +7,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 use sylva_core::animate::akagi::{Akagi, AkagiParams};
+use sylva_core::animate::hsm::{Hsm, HsmParams};
 use sylva_core::animate::skjermo::{Skjermo, SkjermoParams};
 use sylva_core::animate::zioma::{Lod, Zioma, ZiomaParams};
 use sylva_core::animate::{Pose, displacement};
@@ -23,6 +24,9 @@ pub enum Method {
     Akagi,
     /// Skjermo §4: one Bézier per stem, re-attached and bent by the wind each step.
     Skjermo,
+    /// Song et al.: hierarchical shape matching, every segment and leaf a cluster of
+    /// particles (CPU only so far).
+    Hsm,
 }
 
 /// Where to run.
@@ -163,6 +167,20 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
                 }
                 Ok(g.read(ctx, &method)?)
             })
+        }
+        (Method::Hsm, None) => {
+            let method = Hsm::new(tree_ref, HsmParams::default())?;
+            println!("hsm: {} clusters, {} particles", method.layout.cluster_count(), method.layout.particle_count());
+            let mut state = method.rest_state();
+            Box::new(move |_, dt| {
+                if dt > 0.0 {
+                    method.step(&fields, &waves, &mut state, dt);
+                }
+                Ok(method.pose(tree_ref, &state))
+            })
+        }
+        (Method::Hsm, Some(_)) => {
+            bail!("--method hsm runs on the CPU only so far; use --backend cpu")
         }
         (Method::Akagi, Some(ctx)) => {
             let method = Akagi::new(tree_ref, AkagiParams::default());

@@ -187,6 +187,14 @@ fn simulate_runs_akagi_too() {
     );
     assert!(ok, "{err}");
     assert!(out.contains("Skjermo on Cpu"), "{out}");
+    let (ok, out, err) = sylva(
+        dir.path(),
+        &["simulate", "--method", "hsm", "--species", "stochastic_bush", "--seconds", "1", "--fps", "30"],
+    );
+    assert!(ok, "{err}");
+    assert!(out.contains("Hsm on Cpu") && out.contains("clusters") && !out.contains("speed 0.000"), "{out}");
+    let (ok, _, err) = sylva(dir.path(), &["simulate", "--method", "hsm", "--backend", "gpu"]);
+    assert!(!ok && err.contains("--backend cpu"), "{err}");
     let (ok, _, err) = sylva(dir.path(), &["simulate", "--method", "akagi", "--trunk-only"]);
     assert!(!ok && err.contains("--trunk-only"), "{err}");
 }

@@ -20,6 +20,7 @@
 //! position and orientation, plus animated Bézier control points for methods that have them.
 
 pub mod akagi;
+pub mod hsm;
 pub mod skjermo;
 pub mod skjermo_lanes;
 pub mod zioma;

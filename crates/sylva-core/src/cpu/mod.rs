@@ -2,6 +2,7 @@
 //! their WGSL twins in `sylva-gpu/src/shader/` (`cpu::x` ↔ `shader/x.wgsl`).
 
 pub mod akagi;
+pub mod hsm;
 pub mod noise;
 pub mod pose_fk;
 mod segment_ends;
