@@ -163,14 +163,7 @@ impl Akagi {
             mass[i] = m_sub;
             inertia[i] = inert.max(1e-12);
         }
-        // Mechanical radius: at least `min_radius`, and by Leonardo's rule at least the
-        // radius whose cross-section equals its children's together (a joint carries what
-        // grows beyond it). Generators taper radii for looks; the mechanics need this.
-        let mut r_mech = vec![0.0f32; n];
-        for i in (0..n).rev() {
-            let carried: f32 = tree.children.of(i).iter().map(|&c| r_mech[c as usize].powi(2)).sum();
-            r_mech[i] = s.radius_base[i].max(params.min_radius).max(carried.sqrt());
-        }
+        let r_mech = super::mechanical_radii(tree, params.min_radius);
         let segments = (0..n)
             .map(|i| {
                 let k = tree.wood.segment_stiffness(s.length[i], r_mech[i]);

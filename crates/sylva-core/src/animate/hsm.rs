@@ -457,13 +457,7 @@ impl HsmLayout {
         // (K, μ) of a segment cluster; (k, 0) of a leaf.
         let mut stiffness: Vec<(f32, f32)> = Vec::with_capacity(total_clusters);
         let pi = std::f32::consts::PI;
-        // Mechanical radius (as Akagi's): never thinner than `min_radius`, nor than the
-        // radius whose section equals the children's together (Leonardo's rule).
-        let mut r_mech = vec![0.0f32; s.len()];
-        for i in (0..s.len()).rev() {
-            let carried: f32 = tree.children.of(i).iter().map(|&c| r_mech[c as usize].powi(2)).sum();
-            r_mech[i] = s.radius_base[i].max(params.min_radius).max(carried.sqrt());
-        }
+        let r_mech = super::mechanical_radii(tree, params.min_radius);
         #[allow(clippy::needless_range_loop)] // i indexes every per-segment array of the tree
         'segments: for i in 0..s.len() {
             if b.layout.info.len() >= total_clusters {

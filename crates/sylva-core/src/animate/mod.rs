@@ -110,6 +110,20 @@ impl Pose {
     }
 }
 
+/// Mechanical radius of each segment, m: its own base radius, but never thinner than
+/// `min_radius` nor than the radius whose section equals its children's together
+/// (Leonardo's rule — a joint carries what grows beyond it). Generators taper radii for
+/// looks; the mechanics of Akagi's joints and HSM's clusters need this.
+pub fn mechanical_radii(tree: &Tree, min_radius: f32) -> Vec<f32> {
+    let s = &tree.segments;
+    let mut r = vec![0.0f32; s.len()];
+    for i in (0..s.len()).rev() {
+        let carried: f32 = tree.children.of(i).iter().map(|&c| r[c as usize].powi(2)).sum();
+        r[i] = s.radius_base[i].max(min_radius).max(carried.sqrt());
+    }
+    r
+}
+
 /// Tip displacement statistics of a pose against rest, per level.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Displacement {
