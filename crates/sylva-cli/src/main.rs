@@ -3,6 +3,7 @@
 //! With no arguments, runs the main job on the built-in default scene. Until the renderer
 //! lands that is `sylva generate` on the default species.
 
+mod bench_cmd;
 mod simulate_cmd;
 mod wind_cmd;
 
@@ -32,6 +33,8 @@ enum Command {
     Wind(wind_cmd::WindArgs),
     /// Animate a tree in the wind and report how it moved (optionally a CSV trajectory).
     Simulate(simulate_cmd::SimulateArgs),
+    /// Reproduce a paper's result table on the CPU and the GPU, with plots.
+    Bench(bench_cmd::BenchArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -75,6 +78,12 @@ fn main() -> Result<()> {
             Ok(())
         }
         Some(Command::Simulate(args)) => simulate_cmd::run(&args),
+        Some(Command::Bench(args)) => {
+            for p in bench_cmd::run(&args)? {
+                println!("wrote {}", p.display());
+            }
+            Ok(())
+        }
         Some(Command::Wind(args)) => {
             for p in wind_cmd::run(&args)? {
                 println!("wrote {}", p.display());

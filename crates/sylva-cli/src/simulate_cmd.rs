@@ -179,8 +179,16 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
                 Ok(method.pose(tree_ref, &state))
             })
         }
-        (Method::Hsm, Some(_)) => {
-            bail!("--method hsm runs on the CPU only so far; use --backend cpu")
+        (Method::Hsm, Some(ctx)) => {
+            let method = Hsm::new(tree_ref, HsmParams::default())?;
+            println!("hsm: {} clusters, {} particles", method.layout.cluster_count(), method.layout.particle_count());
+            let mut g = sylva_gpu::hsm::GpuHsm::new(ctx, Some(tree_ref), &method, wind_ref)?;
+            Box::new(move |_, dt| {
+                if dt > 0.0 {
+                    g.step(ctx, &method, dt);
+                }
+                Ok(g.read_pose(ctx)?.expect("built with the tree"))
+            })
         }
         (Method::Akagi, Some(ctx)) => {
             let method = Akagi::new(tree_ref, AkagiParams::default());

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use sylva_core::cpu::wind_sample;
 use sylva_core::wind::WindScene;
 
-const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+pub(crate) const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 /// Picks one curve's value from (velocity, speed).
 type Component = Box<dyn Fn(&[f32; 4], f32) -> f32>;

@@ -193,8 +193,6 @@ fn simulate_runs_akagi_too() {
     );
     assert!(ok, "{err}");
     assert!(out.contains("Hsm on Cpu") && out.contains("clusters") && !out.contains("speed 0.000"), "{out}");
-    let (ok, _, err) = sylva(dir.path(), &["simulate", "--method", "hsm", "--backend", "gpu"]);
-    assert!(!ok && err.contains("--backend cpu"), "{err}");
     let (ok, _, err) = sylva(dir.path(), &["simulate", "--method", "akagi", "--trunk-only"]);
     assert!(!ok && err.contains("--trunk-only"), "{err}");
 }
@@ -214,4 +212,67 @@ fn simulate_rejects_bad_input() {
         assert!(!ok, "{args:?} succeeded");
         assert!(err.contains(needle), "{args:?}: {err}");
     }
+}
+
+#[test]
+fn simulate_runs_hsm_on_the_gpu() {
+    if sylva_gpu::GpuContext::shared().is_err() {
+        assert!(std::env::var("CI").is_err(), "CI requires a GPU adapter");
+        eprintln!("skipping: no GPU adapter");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let args = ["simulate", "--method", "hsm", "--species", "stochastic_bush", "--seconds", "0.5", "--fps", "30"];
+    let (ok, out, err) = sylva(dir.path(), &[&args[..], &["--backend", "gpu"]].concat());
+    assert!(ok, "{err}");
+    assert!(out.contains("Hsm on Gpu") && out.contains("16 frames") && !out.contains("speed 0.000"), "{out}");
+}
+
+#[test]
+fn bench_quick_writes_complete_tables() {
+    let gpu = sylva_gpu::GpuContext::shared().is_ok();
+    if !gpu {
+        assert!(std::env::var("CI").is_err(), "CI requires a GPU adapter");
+        eprintln!("timing the CPU only: no GPU adapter");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let backend = if gpu { "both" } else { "cpu" };
+    let (ok, out, err) = sylva(dir.path(), &["bench", "all", "--quick", "--backend", backend, "--out-dir", "b"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("copy bandwidth"), "{out}");
+    for table in ["song-t2", "song-t3"] {
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join(format!("b/{table}.json"))).unwrap())
+                .unwrap();
+        assert_eq!(json["table"], table);
+        assert!(json["machine"]["cpu_bandwidth"].as_f64().unwrap() > 0.0);
+        assert!(json["machine"]["command"].as_str().unwrap().contains("bench all"));
+        let rows = json["rows"].as_array().unwrap();
+        assert_eq!(rows.len(), 3, "--quick runs the three smallest sizes");
+        let mut last = 0;
+        for r in rows {
+            let particles = r["particles"].as_u64().unwrap();
+            assert!(particles > last, "rows grow");
+            last = particles;
+            assert!(r["bytes_per_step"].as_u64().unwrap() > particles);
+            let cpu = &r["cpu"];
+            assert!(cpu["median"].as_f64().unwrap() > 0.0);
+            assert!(cpu["min"].as_f64().unwrap() <= cpu["median"].as_f64().unwrap());
+            assert!(cpu["median"].as_f64().unwrap() <= cpu["max"].as_f64().unwrap());
+            assert!(cpu["samples"].as_u64().unwrap() >= 3);
+            assert_eq!(r["gpu"].is_null(), !gpu);
+        }
+        let md = std::fs::read_to_string(dir.path().join(format!("b/{table}.md"))).unwrap();
+        assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 2 + 3, "{md}");
+        let png = std::fs::read(dir.path().join(format!("b/{table}.png"))).unwrap();
+        assert_eq!(&png[..4], b"\x89PNG");
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path().join("b"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    let (ok, _, err) = sylva(dir.path(), &["bench", "song-t2", "--budget", "0"]);
+    assert!(!ok && err.contains("--budget"), "{err}");
 }

@@ -51,7 +51,7 @@ fn a_rigidly_moved_cluster_has_goals_at_its_positions() {
         for _ in 0..8 {
             hsm_clusters(&[], &[], &l.info, &l.clusters, &l.slots, &s.position, &l.rest, step, &mut s.clusters);
         }
-        hsm_goals(&l.slots, &l.member_offset, &l.member, &l.rest, &s.clusters, &mut s.goal);
+        hsm_goals(&l.member_offset, &l.member, &l.rest, &s.clusters, &mut s.goal);
         for (i, (g, x)) in s.goal.iter().zip(&s.position).enumerate() {
             let d = (Vec3::new(g[0], g[1], g[2]) - Vec3::new(x[0], x[1], x[2])).length();
             assert!(d <= 1e-5, "trial {trial}: particle {i} goal off by {d} m");
@@ -247,6 +247,30 @@ fn hsm_is_identical_on_any_thread_count() {
 /// The layout is Song's linearised tree: parents before children, children lists that
 /// point back, shared particles listed under every cluster that holds them, the root ring
 /// fixed, and a forest of copies that is the same layout repeated.
+/// The fused particle pass (stages 3 and 4 in one) gives Song's four stages bit for bit.
+#[test]
+fn fused_particle_stages_match_the_four_stages_exactly() {
+    let t = tree("ca_black_oak");
+    let wind = WindScene::resolve("gusty").unwrap();
+    let four = HsmParams { fused: false, ..Default::default() };
+    let fused = HsmParams { fused: true, ..four };
+    let layout = HsmLayout::new(&t, &four, Some(2_000)).unwrap();
+    let run = |params| {
+        let h = Hsm::from_layout(&t, params, layout.clone());
+        let mut s = h.rest_state();
+        for _ in 0..120 {
+            h.step_scene(&wind, &mut s, 1.0 / 60.0);
+        }
+        s
+    };
+    let (a, b) = (run(four), run(fused));
+    assert_eq!(a.position, b.position);
+    assert_eq!(a.velocity, b.velocity);
+    assert_eq!(a.clusters, b.clusters);
+    // Only the four-stage path keeps the goal buffer.
+    assert_ne!(a.goal, b.goal);
+}
+
 #[test]
 fn the_layout_links_clusters_head_to_tail() {
     let t = tree("sympodial");
@@ -274,7 +298,9 @@ fn the_layout_links_clusters_head_to_tail() {
     }
     for (i, w) in l.member_offset.windows(2).enumerate() {
         for m in &l.member[w[0] as usize..w[1] as usize] {
-            assert_eq!(l.slots[m[1] as usize].particle, i as u32);
+            let c = &l.info[m.cluster as usize];
+            let run = &l.slots[c.slot_offset as usize..(c.slot_offset + c.slot_count) as usize];
+            assert!(run.iter().any(|s| s.particle == i as u32 && s.q == m.q), "particle {i}: member {m:?}");
         }
     }
     assert_eq!(l.free.iter().filter(|f| **f == 0.0).count(), params.ring_size as usize);

@@ -12,6 +12,7 @@
 //!   composed into each kernel, never copied.
 
 mod context;
+pub mod hsm;
 pub mod kernel;
 pub mod pose;
 pub mod segment_ends;

@@ -140,6 +140,24 @@ impl GpuPose {
         }
     }
 
+    /// Runs only the joint positions, from rotations a method wrote straight into
+    /// [`Self::acc_buffer`] (methods whose rotations are already world rotations, as HSM's
+    /// cluster R).
+    pub fn record_positions(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+        let total = (self.n * self.instances) as u32;
+        self.positions.record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, &self.joints], total);
+    }
+
+    /// The buffer of accumulated (world) rotations D.
+    pub fn acc_buffer(&self) -> &wgpu::Buffer {
+        &self.acc
+    }
+
+    /// Number of segments of one instance.
+    pub fn segment_count(&self) -> usize {
+        self.n
+    }
+
     /// Forward kinematics of given rotations, read back as a [`Pose`].
     pub fn pose_from_rotations(&self, ctx: &GpuContext, delta: &[[f32; 4]]) -> Result<Pose, GpuError> {
         ctx.queue.write_buffer(&self.delta, 0, bytemuck::cast_slice(delta));

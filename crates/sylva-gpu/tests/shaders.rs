@@ -274,3 +274,75 @@ fn animation_structs_match_their_wgsl_twins() {
         ],
     );
 }
+
+#[test]
+fn hsm_structs_match_their_wgsl_twins() {
+    use sylva_core::animate::hsm::{
+        RawHsmCluster, RawHsmClusterInfo, RawHsmClusterState, RawHsmMember, RawHsmSlot, RawHsmStep,
+    };
+    use sylva_gpu::shader::{HSM, QUAT};
+    let hsm = compose(&[QUAT, HSM]);
+    check_in(
+        &hsm,
+        "HsmClusterInfo",
+        size_of::<RawHsmClusterInfo>(),
+        &[
+            ("kind", offset_of!(RawHsmClusterInfo, kind)),
+            ("source", offset_of!(RawHsmClusterInfo, source)),
+            ("slot_offset", offset_of!(RawHsmClusterInfo, slot_offset)),
+            ("slot_count", offset_of!(RawHsmClusterInfo, slot_count)),
+        ],
+    );
+    check_in(
+        &hsm,
+        "HsmCluster",
+        size_of::<RawHsmCluster>(),
+        &[
+            ("rest_cm", offset_of!(RawHsmCluster, rest_cm)),
+            ("parent", offset_of!(RawHsmCluster, parent)),
+            ("child_offset", offset_of!(RawHsmCluster, child_offset)),
+            ("child_count", offset_of!(RawHsmCluster, child_count)),
+            ("mass", offset_of!(RawHsmCluster, mass)),
+            ("aqq_inv", offset_of!(RawHsmCluster, aqq_inv)),
+        ],
+    );
+    check_in(
+        &hsm,
+        "HsmSlot",
+        size_of::<RawHsmSlot>(),
+        &[("q", offset_of!(RawHsmSlot, q)), ("particle", offset_of!(RawHsmSlot, particle))],
+    );
+    check_in(
+        &hsm,
+        "HsmMember",
+        size_of::<RawHsmMember>(),
+        &[("q", offset_of!(RawHsmMember, q)), ("cluster", offset_of!(RawHsmMember, cluster))],
+    );
+    check_in(
+        &hsm,
+        "HsmClusterState",
+        size_of::<RawHsmClusterState>(),
+        &[
+            ("cm", offset_of!(RawHsmClusterState, cm)),
+            ("rotation", offset_of!(RawHsmClusterState, rotation)),
+            ("transform", offset_of!(RawHsmClusterState, transform)),
+            ("wind", offset_of!(RawHsmClusterState, wind)),
+        ],
+    );
+    check_in(
+        &hsm,
+        "HsmStep",
+        size_of::<RawHsmStep>(),
+        &[
+            ("gravity", offset_of!(RawHsmStep, gravity)),
+            ("dt", offset_of!(RawHsmStep, dt)),
+            ("time", offset_of!(RawHsmStep, time)),
+            ("damping", offset_of!(RawHsmStep, damping)),
+            ("beta", offset_of!(RawHsmStep, beta)),
+            ("polar_iterations", offset_of!(RawHsmStep, polar_iterations)),
+            ("clusters", offset_of!(RawHsmStep, clusters)),
+            ("particles", offset_of!(RawHsmStep, particles)),
+            ("max_children", offset_of!(RawHsmStep, max_children)),
+        ],
+    );
+}

@@ -23,8 +23,9 @@
 //! per-step [`RawHsmClusterState`]: current centre of mass, R, the goal transform, the
 //! wind), and *particle data* (position + mass, velocity + free flag, rest position + drag,
 //! owner). A cluster's particles are its run of [`RawHsmSlot`]s (particle index and rest
-//! offset `q = x⁰ − c⁰`); each particle lists the (cluster, slot) pairs it belongs to, so a
-//! particle's goal is a deterministic gather over its clusters, never a float atomic.
+//! offset `q = x⁰ − c⁰`); each particle lists the clusters it belongs to with its offset in
+//! each ([`RawHsmMember`]), so a particle's goal is a deterministic gather over its
+//! clusters, never a float atomic.
 //!
 //! # The step (Table 1, §5.2's four stages)
 //! 1. `hsm_clusters` (one GPU workgroup per cluster, shared-memory reduction): centre of
@@ -33,14 +34,21 @@
 //!    `β = 0` is pure rotation), α of the cluster and the wind at `c`.
 //! 2. Synchronisation: the end of the dispatch.
 //! 3. `hsm_goals` (per particle): over the clusters sharing it, `g_c = T_c q + c_c`; the goal
-//!    is the α-weighted mean `ĝ = Σ α_c g_c / Σ α_c` with `ᾱ = Σ α_c / n` (Table 1 steps
-//!    3–4 when every α is equal).
+//!    is the α-weighted mean `ĝ = Σ α_c g_c / Σ α_c` with `ᾱ = min(1, Σ α_c)` (Table 1
+//!    steps 3–4 take `Σ α / n`; with n, a ring shared by twenty leaves had its segment's
+//!    hold diluted twentyfold).
 //! 4. `hsm_integrate` (per particle): `v += ᾱ (ĝ − x) / h + h g` (Table 1 steps 5–6; a
 //!    prestressed tree's support cancels g, see [`HsmParams::prestressed`]),
 //!    drag toward the wind `u` sampled at its cluster's centre (a leaf's segment's)
 //!    `v += (u − v) s / (1 + s)`,
 //!    `s = h k_d |u − v|` (semi-implicit, so it never overshoots the air), damping
 //!    `v *= e^{−c h}`, then `x += h v` (step 7).
+//!
+//! Stages 3 and 4 run as one pass by default (`hsm_particles`, see [`HsmParams::fused`]):
+//! the same numbers bit for bit, without the goal buffer.
+//!
+//! The GPU twins (`sylva_gpu::hsm::GpuHsm`) run the same stages over the same buffers, every
+//! substep of a step in one submission.
 //!
 //! **Stiffness** is a rate, not a per-step fraction: `α = min(1, k h²)` with `k` in 1/s²
 //! (per level, trunk stiffest). Then `v += k h (g − x)` is a spring of angular frequency √k
@@ -59,7 +67,7 @@
 //! (see the tests).
 
 use super::Pose;
-use crate::cpu::hsm::{hsm_clusters, hsm_goals, hsm_integrate, hsm_pose};
+use crate::cpu::hsm::{hsm_clusters, hsm_goals, hsm_integrate, hsm_particles, hsm_pose};
 use crate::model::{NONE, Tree};
 use crate::wind::WindScene;
 use crate::wind::raw::{RawField, RawWave};
@@ -141,6 +149,13 @@ pub struct HsmParams {
     /// motion and the second refines it; a cold start (a cluster rotated far in one step)
     /// needs up to about 20.
     pub polar_iterations: u32,
+    /// Run stages 3 and 4 as one pass per particle (`hsm_particles`) instead of two
+    /// (`hsm_goals`, then `hsm_integrate` through the goal buffer). Default true: a
+    /// particle's gathered goal is read by no other particle, so the fused pass gives the
+    /// same numbers bit for bit while moving about a quarter fewer bytes per step (see
+    /// `docs/PERFORMANCE.md`). False runs Song's four stages as published and keeps
+    /// [`HsmState::goal`] up to date (the fused pass leaves it as it was).
+    pub fused: bool,
     /// Substeps per `step` call. Default 4: 240 Hz at 60 frames/s keeps α below 1 for the
     /// default stiffness, so the trunk's sag and sway do not depend on the frame rate.
     pub substeps: u32,
@@ -165,10 +180,43 @@ impl Default for HsmParams {
             prestressed: true,
             beta: 0.0,
             polar_iterations: 2,
+            fused: true,
             substeps: 4,
         }
     }
 }
+
+impl HsmParams {
+    /// The cluster sizes of Song's Tables 2 and 3 (42–60 particles per cluster): segment
+    /// clusters of 4 rings of 14 (42 particles of their own, 56 at the root), leaves of 42
+    /// blade particles, no stem clusters (the paper's counts have none), one substep per step
+    /// (the paper's frame is one shape-matching pass).
+    pub fn song_tables() -> Self {
+        Self { rings: 4, ring_size: 14, leaf_particles: 42, stem_clusters: false, substeps: 1, ..Self::default() }
+    }
+}
+
+/// Song's Table 2 (one tree on a GTX 580): clusters, particles, frames per second.
+pub const SONG_TABLE_2: [(usize, usize, f64); 7] = [
+    (5, 300, 2200.0),
+    (15, 900, 1800.0),
+    (67, 3444, 1400.0),
+    (293, 13548, 1000.0),
+    (867, 38772, 670.0),
+    (2230, 99816, 350.0),
+    (4975, 211812, 175.0),
+];
+
+/// Song's Table 3 (ten trees on a GTX 580): clusters, particles, frames per second.
+pub const SONG_TABLE_3: [(usize, usize, f64); 7] = [
+    (50, 3000, 260.0),
+    (150, 9000, 210.0),
+    (670, 34440, 160.0),
+    (2930, 135480, 110.0),
+    (8670, 387720, 70.0),
+    (22300, 998160, 36.0),
+    (49750, 2118120, 17.0),
+];
 
 /// An unusable parameter or a layout beyond its limits.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -276,6 +324,18 @@ pub struct RawHsmSlot {
     pub particle: u32,
 }
 
+/// One cluster a particle belongs to, with the particle's rest offset in it, 16 bytes
+/// (the particle's side of a [`RawHsmSlot`], so stage 3 reads one record per cluster).
+/// WGSL: `HsmMember`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawHsmMember {
+    /// Rest offset from the cluster's rest centre of mass, q = x⁰ − c⁰, m.
+    pub q: [f32; 3],
+    /// Cluster index.
+    pub cluster: u32,
+}
+
 /// Cluster data written each step (Fig. 9's current CM, A), 96 bytes. WGSL: `HsmClusterState`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
@@ -349,8 +409,8 @@ pub struct HsmLayout {
     pub owner: Vec<u32>,
     /// Start of each particle's run in `member` (one more entry than particles).
     pub member_offset: Vec<u32>,
-    /// (cluster, slot) pairs of every particle, in cluster order.
-    pub member: Vec<[u32; 2]>,
+    /// The clusters of every particle with its rest offset in each, in cluster order.
+    pub member: Vec<RawHsmMember>,
     /// Cluster of each segment of the tree (`u32::MAX` where a truncated layout has none).
     pub segment_cluster: Vec<u32>,
     /// Largest number of child clusters of any cluster.
@@ -674,12 +734,12 @@ impl HsmLayout {
         for i in 0..n_particles {
             count[i + 1] += count[i];
         }
-        let mut member = vec![[0u32; 2]; slots.len()];
+        let mut member = vec![RawHsmMember { q: [0.0; 3], cluster: 0 }; slots.len()];
         let mut fill = count.clone();
         for (c, info) in b.layout.info.iter().enumerate() {
             for sl in info.slot_offset..info.slot_offset + info.slot_count {
                 let p = slots[sl as usize].particle as usize;
-                member[fill[p] as usize] = [c as u32, sl];
+                member[fill[p] as usize] = RawHsmMember { q: slots[sl as usize].q, cluster: c as u32 };
                 fill[p] += 1;
             }
         }
@@ -722,7 +782,7 @@ impl HsmLayout {
             out.owner.extend(self.owner.iter().map(|o| o + k * nc));
             let base = *out.member_offset.last().expect("offsets");
             out.member_offset.extend(self.member_offset[1..].iter().map(|o| o + base));
-            out.member.extend(self.member.iter().map(|m| [m[0] + k * nc, m[1] + k * ns]));
+            out.member.extend(self.member.iter().map(|m| RawHsmMember { cluster: m.cluster + k * nc, ..*m }));
         }
         Ok(out)
     }
@@ -737,17 +797,26 @@ impl HsmLayout {
         self.rest.len()
     }
 
-    /// Bytes the four stages read and write per substep (each array counted once per stage
-    /// that touches it), for bandwidth figures.
-    pub fn bytes_per_step(&self) -> usize {
+    /// Bytes the stages must read and write per substep, each array counted once per
+    /// stage that touches it (a lower bound on the traffic: gathered values are counted at
+    /// their size, not their cache lines), for bandwidth figures. `fused`: stages 3 and 4
+    /// in one pass.
+    pub fn bytes_per_step(&self, fused: bool) -> usize {
         let (c, p, s, m) = (self.info.len(), self.rest.len(), self.slots.len(), self.member.len());
-        // Stage 1: info, clusters, cluster state (r/w), slots, positions via slots.
-        let stage1 = c * (16 + 80 + 2 * 96) + s * (16 + 16);
-        // Stage 3: offsets, members, slots and cluster state per member, position, goal.
-        let stage3 = p * (4 + 16 + 16) + m * (8 + 16 + 64);
+        // Stage 1: info, clusters, cluster state (r/w), slots, position and rest per slot.
+        let stage1 = c * (16 + 80 + 2 * 96) + s * (16 + 16 + 16);
+        // Stage 3: offsets, rest, goal written; per member: the record (q, cluster), the
+        // cluster's transform and α.
+        let members = m * (16 + 52);
+        let stage3 = p * (4 + 16 + 16) + members;
         // Stage 4: position, velocity (r/w), rest, owner, goal, owner's wind.
         let stage4 = p * (2 * 16 + 2 * 16 + 16 + 4 + 16 + 16);
-        stage1 + stage3 + stage4
+        if fused {
+            // One pass: no goal written or read, rest read once.
+            p * (4 + 2 * 16 + 2 * 16 + 16 + 4 + 16) + members + stage1
+        } else {
+            stage1 + stage3 + stage4
+        }
     }
 }
 
@@ -817,8 +886,29 @@ impl Hsm {
             step,
             &mut state.clusters,
         );
-        hsm_goals(&l.slots, &l.member_offset, &l.member, &l.rest, &state.clusters, &mut state.goal);
-        hsm_integrate(&l.rest, &l.owner, &state.clusters, &state.goal, step, &mut state.position, &mut state.velocity);
+        if self.params.fused {
+            hsm_particles(
+                &l.member_offset,
+                &l.member,
+                &l.rest,
+                &l.owner,
+                &state.clusters,
+                step,
+                &mut state.position,
+                &mut state.velocity,
+            );
+        } else {
+            hsm_goals(&l.member_offset, &l.member, &l.rest, &state.clusters, &mut state.goal);
+            hsm_integrate(
+                &l.rest,
+                &l.owner,
+                &state.clusters,
+                &state.goal,
+                step,
+                &mut state.position,
+                &mut state.velocity,
+            );
+        }
         state.time = step.time;
     }
 

@@ -1,14 +1,19 @@
 //! CPU twins of `shader/hsm_clusters.wgsl`, `hsm_goals.wgsl`, `hsm_integrate.wgsl` and
 //! `hsm_pose.wgsl`: Song's four stages (see [`crate::animate::hsm`]). Same operations in the
-//! same order as the WGSL, except that the GPU sums a cluster's particles as a tree in shared
-//! memory where this sums them in slot order.
+//! same order as the WGSL: a cluster's sums go through the GPU's [`LANES`] lanes (lane `j mod
+//! 64` takes slot `j`) and the same halving tree, so both sides add in the same order.
 
-use crate::animate::hsm::{RawHsmCluster, RawHsmClusterInfo, RawHsmClusterState, RawHsmSlot, RawHsmStep, kind};
+use crate::animate::hsm::{
+    RawHsmCluster, RawHsmClusterInfo, RawHsmClusterState, RawHsmMember, RawHsmSlot, RawHsmStep, kind,
+};
 use crate::cpu::wind_sample::wind_at;
 use crate::model::NONE;
 use crate::wind::raw::{RawField, RawWave};
-use glam::{Mat3, Quat, Vec3};
+use glam::{Mat3, Quat, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
+
+/// Invocations per cluster in `hsm_clusters.wgsl` (its workgroup size).
+pub const LANES: usize = 64;
 
 #[inline]
 fn v3(a: [f32; 4]) -> Vec3 {
@@ -53,26 +58,44 @@ pub fn hsm_clusters(
     step: RawHsmStep,
     state: &mut [RawHsmClusterState],
 ) {
-    state.par_iter_mut().enumerate().with_min_len(64).for_each(|(c, st)| {
+    // Scratch lanes, one set per rayon job (not per cluster: only the lanes a cluster uses
+    // are reset).
+    let scratch = || vec![[Vec3A::ZERO; 4]; LANES];
+    state.par_iter_mut().enumerate().with_min_len(64).for_each_init(scratch, |lane, (c, st)| {
         let inf = info[c];
         let cl = &clusters[c];
         let c0 = v3(cl.rest_cm);
-        let mut sm = Vec3::ZERO;
-        let mut a0 = Vec3::ZERO;
-        let mut a1 = Vec3::ZERO;
-        let mut a2 = Vec3::ZERO;
-        for s in &slots[inf.slot_offset as usize..(inf.slot_offset + inf.slot_count) as usize] {
+        // Lane sums [Σ m u, Apq columns] of the workgroup's invocations (lane j mod 64 adds
+        // slot j, starting from zero); lanes past the slot count stay zero, so the reduction
+        // below needs only the next power of two.
+        let run = &slots[inf.slot_offset as usize..(inf.slot_offset + inf.slot_count) as usize];
+        let width = run.len().clamp(1, LANES).next_power_of_two();
+        lane[..width].fill([Vec3A::ZERO; 4]);
+        for (j, s) in run.iter().enumerate() {
             let x = position[s.particle as usize];
             let m = x[3];
-            let u = v3(x) - v3(rest[s.particle as usize]);
-            let q = Vec3::from_array(s.q);
-            sm += u * m;
+            let u = a3(x) - a3(rest[s.particle as usize]);
+            let q = Vec3A::from_array(s.q);
             // d = x − c⁰ = u + q; (d qⱼ) m keeps Apq symmetric when u = 0.
             let d = u + q;
-            a0 += (d * q.x) * m;
-            a1 += (d * q.y) * m;
-            a2 += (d * q.z) * m;
+            let l = &mut lane[j % LANES];
+            l[0] += u * m;
+            l[1] += (d * q.x) * m;
+            l[2] += (d * q.y) * m;
+            l[3] += (d * q.z) * m;
         }
+        let mut stride = width / 2;
+        while stride > 0 {
+            // Invocation t < stride adds lane t + stride to lane t (one barrier per level).
+            let (low, high) = lane.split_at_mut(stride);
+            for (a, b) in low.iter_mut().zip(&high[..stride]) {
+                for (x, y) in a.iter_mut().zip(b) {
+                    *x += *y;
+                }
+            }
+            stride /= 2;
+        }
+        let [sm, a0, a1, a2] = lane[0].map(Vec3::from);
         let shift = sm / cl.mass;
         let cm = c0 + shift;
         // Σ m q = 0, so Σ m (x − c⁰) qᵀ is Apq = Σ m (x − c) qᵀ.
@@ -99,40 +122,78 @@ pub fn hsm_clusters(
     });
 }
 
+/// A particle's goal (xyz) and ᾱ (w): the α-weighted mean over its clusters (see
+/// [`hsm_goals`]). WGSL: the loop of `hsm_goals.wgsl` and `hsm_particles.wgsl` around
+/// `hsm_goal_displacement`.
+#[inline(always)]
+fn particle_goal(
+    i: usize,
+    member_offset: &[u32],
+    member: &[RawHsmMember],
+    rest: &[[f32; 4]],
+    state: &[RawHsmClusterState],
+) -> [f32; 4] {
+    let lo = member_offset[i] as usize;
+    let hi = member_offset[i + 1] as usize;
+    let mut sum = Vec3A::ZERO;
+    let mut wsum = 0.0f32;
+    for m in &member[lo..hi] {
+        let st = &state[m.cluster as usize];
+        sum += goal_displacement(st, Vec3A::from_array(m.q)) * st.cm[3];
+        wsum += st.cm[3];
+    }
+    let x0 = a3(rest[i]);
+    if wsum > 0.0 { with_xyz(x0 + sum / wsum, wsum.min(1.0)) } else { with_xyz(x0, 0.0) }
+}
+
+/// A cluster's goal for rest offset `q`, as a displacement from rest: `(T q − q) + (c − c⁰)`.
+/// WGSL: `hsm_goal_displacement`.
+#[inline(always)]
+fn goal_displacement(st: &RawHsmClusterState, q: Vec3A) -> Vec3A {
+    let t = &st.transform;
+    let tq = a3(t[0]) * q.x + a3(t[1]) * q.y + a3(t[2]) * q.z;
+    let shift = Vec3A::new(t[0][3], t[1][3], t[2][3]);
+    (tq - q) + shift
+}
+
+/// A free particle's new velocity: the pull toward goal `g` (w = ᾱ), gravity, semi-implicit
+/// drag toward `wind` with drag factor `kd`, damping. WGSL: `hsm_velocity`.
+#[inline(always)]
+fn particle_velocity(v: Vec3A, g: [f32; 4], p: Vec3A, wind: Vec3A, kd: f32, step: &RawHsmStep) -> Vec3A {
+    let h = step.dt;
+    let gravity = Vec3A::from_array([step.gravity[0], step.gravity[1], step.gravity[2]]);
+    let mut vel = v + (a3(g) - p) * (g[3] / h) + gravity * ((1.0 - step.gravity[3]) * h);
+    let rel = wind - vel;
+    let s = h * kd * rel.length();
+    vel += rel * (s / (1.0 + s));
+    vel * step.damping
+}
+
+/// The xyz of a 16-byte record in a 4-wide register.
+#[inline(always)]
+fn a3(x: [f32; 4]) -> Vec3A {
+    Vec3A::from_vec4(Vec4::from_array(x))
+}
+
+/// A record's xyz replaced, w kept.
+#[inline(always)]
+fn with_xyz(v: Vec3A, w: f32) -> [f32; 4] {
+    v.extend(w).to_array()
+}
+
 /// Stage 3, per particle: the α-weighted mean of its clusters' goals `T_c q + c_c`, and
 /// `ᾱ = min(1, Σ α_c)`. Goals are formed as displacements from rest, `x⁰ + (T q − q) + (c − c⁰)`,
-/// so a cluster at rest gives exactly `x⁰`. Bindings: 0 slots, 1 member offsets, 2 members,
-/// 3 rest positions, 4 cluster state, 5 goals.
+/// so a cluster at rest gives exactly `x⁰`. Bindings: 0 member offsets, 1 members, 2 rest
+/// positions, 3 cluster state, 4 goals.
 pub fn hsm_goals(
-    slots: &[RawHsmSlot],
     member_offset: &[u32],
-    member: &[[u32; 2]],
+    member: &[RawHsmMember],
     rest: &[[f32; 4]],
     state: &[RawHsmClusterState],
     goal: &mut [[f32; 4]],
 ) {
     goal.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, g)| {
-        let lo = member_offset[i] as usize;
-        let hi = member_offset[i + 1] as usize;
-        let mut sum = Vec3::ZERO;
-        let mut wsum = 0.0f32;
-        for m in &member[lo..hi] {
-            let st = &state[m[0] as usize];
-            let q = slots[m[1] as usize].q;
-            let q = Vec3::from_array(q);
-            let tq = v3(st.transform[0]) * q.x + v3(st.transform[1]) * q.y + v3(st.transform[2]) * q.z;
-            let shift = Vec3::new(st.transform[0][3], st.transform[1][3], st.transform[2][3]);
-            let gd = (tq - q) + shift;
-            sum += gd * st.cm[3];
-            wsum += st.cm[3];
-        }
-        let x0 = v3(rest[i]);
-        *g = if wsum > 0.0 {
-            let gg = x0 + sum / wsum;
-            [gg.x, gg.y, gg.z, wsum.min(1.0)]
-        } else {
-            [x0.x, x0.y, x0.z, 0.0]
-        };
+        *g = particle_goal(i, member_offset, member, rest, state);
     });
 }
 
@@ -149,23 +210,44 @@ pub fn hsm_integrate(
     position: &mut [[f32; 4]],
     velocity: &mut [[f32; 4]],
 ) {
-    let h = step.dt;
     position.par_iter_mut().zip(velocity.par_iter_mut()).enumerate().with_min_len(256).for_each(|(i, (x, v))| {
         if v[3] == 0.0 {
             return; // fixed
         }
-        let g = goal[i];
-        let p = v3(*x);
-        let st = &state[owner[i] as usize];
-        let gravity = v3(step.gravity);
-        let mut vel = v3(*v) + (v3(g) - p) * (g[3] / h) + gravity * ((1.0 - step.gravity[3]) * h);
-        let rel = v3(st.wind) - vel;
-        let s = h * rest[i][3] * rel.length();
-        vel += rel * (s / (1.0 + s));
-        vel *= step.damping;
-        let p = p + vel * h;
-        *x = [p.x, p.y, p.z, x[3]];
-        *v = [vel.x, vel.y, vel.z, v[3]];
+        let p = a3(*x);
+        let vel = particle_velocity(a3(*v), goal[i], p, a3(state[owner[i] as usize].wind), rest[i][3], &step);
+        *x = with_xyz(p + vel * step.dt, x[3]);
+        *v = with_xyz(vel, v[3]);
+    });
+}
+
+/// Stages 3 and 4 in one pass per particle: its goal, gathered from its clusters, is read by
+/// no other particle, so it goes straight into the integration instead of through the goal
+/// buffer (Song needs a synchronisation between the two because his goals are scattered
+/// from the clusters). The same operations as [`hsm_goals`] then [`hsm_integrate`], so the
+/// result is bit for bit theirs without the goal buffer's write and re-read. Bindings:
+/// 0 member offsets, 1 members, 2 rest (w = drag factor), 3 owners, 4 cluster state,
+/// 5 step, 6 positions, 7 velocities.
+#[allow(clippy::too_many_arguments)]
+pub fn hsm_particles(
+    member_offset: &[u32],
+    member: &[RawHsmMember],
+    rest: &[[f32; 4]],
+    owner: &[u32],
+    state: &[RawHsmClusterState],
+    step: RawHsmStep,
+    position: &mut [[f32; 4]],
+    velocity: &mut [[f32; 4]],
+) {
+    position.par_iter_mut().zip(velocity.par_iter_mut()).enumerate().with_min_len(256).for_each(|(i, (x, v))| {
+        if v[3] == 0.0 {
+            return; // fixed
+        }
+        let g = particle_goal(i, member_offset, member, rest, state);
+        let p = a3(*x);
+        let vel = particle_velocity(a3(*v), g, p, a3(state[owner[i] as usize].wind), rest[i][3], &step);
+        *x = with_xyz(p + vel * step.dt, x[3]);
+        *v = with_xyz(vel, v[3]);
     });
 }
 

@@ -35,6 +35,18 @@ pub const SKJERMO: &str = include_str!("skjermo.wgsl");
 pub const SKJERMO_STEP: &str = include_str!("skjermo_step.wgsl");
 /// Kernel: seam rotations from Skjermo's curves.
 pub const SKJERMO_ROTATIONS: &str = include_str!("skjermo_rotations.wgsl");
+/// Song's linearised tree (`HsmCluster`, …) and the rotation extraction.
+pub const HSM: &str = include_str!("hsm.wgsl");
+/// Kernel: HSM stage 1, per cluster (workgroup reduction).
+pub const HSM_CLUSTERS: &str = include_str!("hsm_clusters.wgsl");
+/// Kernel: HSM stage 3, per-particle goals.
+pub const HSM_GOALS: &str = include_str!("hsm_goals.wgsl");
+/// Kernel: HSM stage 4, per-particle integration.
+pub const HSM_INTEGRATE: &str = include_str!("hsm_integrate.wgsl");
+/// Kernel: HSM stages 3 and 4 fused, per particle.
+pub const HSM_PARTICLES: &str = include_str!("hsm_particles.wgsl");
+/// Kernel: seam rotations from HSM's clusters.
+pub const HSM_POSE: &str = include_str!("hsm_pose.wgsl");
 /// Kernel: trunk noise bands at many (t, tree) samples.
 pub const TRUNK_NOISE: &str = include_str!("trunk_noise.wgsl");
 
@@ -52,6 +64,11 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("akagi_integrate", &[QUAT, TREE, AKAGI, AKAGI_INTEGRATE]),
     ("skjermo_step", &[QUAT, TREE, NOISE, WIND, SKJERMO, SKJERMO_STEP]),
     ("skjermo_rotations", &[QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS]),
+    ("hsm_clusters", &[QUAT, NOISE, WIND, HSM, HSM_CLUSTERS]),
+    ("hsm_goals", &[QUAT, HSM, HSM_GOALS]),
+    ("hsm_integrate", &[QUAT, HSM, HSM_INTEGRATE]),
+    ("hsm_particles", &[QUAT, HSM, HSM_PARTICLES]),
+    ("hsm_pose", &[QUAT, TREE, HSM, HSM_POSE]),
 ];
 
 /// Concatenates WGSL sources into one module.

@@ -1,0 +1,51 @@
+use std::time::Instant;
+use sylva_core::animate::hsm::*;
+use sylva_core::cpu::hsm::*;
+use sylva_core::species::SpeciesSource;
+use sylva_core::wind::WindScene;
+fn main() {
+    let tree = SpeciesSource::resolve("quaking_aspen").unwrap().generate(1, &Default::default(), None).unwrap();
+    let params = HsmParams::song_tables();
+    let copies: usize = std::env::args().nth(1).map(|s| s.parse().unwrap()).unwrap_or(1);
+    let one = HsmLayout::new(&tree, &params, Some(4975)).unwrap();
+    let l = if copies > 1 { one.forest(copies, 30.0).unwrap() } else { one };
+    let h = Hsm::from_layout(&tree, params, l);
+    let l = &h.layout;
+    let (f, w) = WindScene::resolve(&std::env::var("WIND").unwrap_or("gusty".into())).unwrap().pack();
+    let mut st = h.rest_state();
+    for _ in 0..20 {
+        h.step(&f, &w, &mut st, 1.0 / 60.0);
+    }
+    let n = 50;
+    let step = h.step_params(1.0, 1.0 / 60.0);
+    let (mut t1, mut t3, mut t4, mut tf) = (0.0, 0.0, 0.0, 0.0);
+    for _ in 0..n {
+        let t = Instant::now();
+        hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.position, &l.rest, step, &mut st.clusters);
+        t1 += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        hsm_goals(&l.member_offset, &l.member, &l.rest, &st.clusters, &mut st.goal);
+        t3 += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        hsm_integrate(&l.rest, &l.owner, &st.clusters, &st.goal, step, &mut st.position, &mut st.velocity);
+        t4 += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        hsm_particles(
+            &l.member_offset,
+            &l.member,
+            &l.rest,
+            &l.owner,
+            &st.clusters,
+            step,
+            &mut st.position,
+            &mut st.velocity,
+        );
+        tf += t.elapsed().as_secs_f64();
+    }
+    let np = l.particle_count() as f64;
+    println!("clusters {} particles {} slots {} members {}", l.cluster_count(), np, l.slots.len(), l.member.len());
+    for (name, t) in [("clusters", t1), ("goals", t3), ("integrate", t4), ("fused", tf)] {
+        println!("{name:>10}: {:.3} ms/step, {:.2} ns/particle", t / n as f64 * 1e3, t / n as f64 / np * 1e9);
+    }
+    println!("four-stage {:.1} steps/s, fused {:.1}", n as f64 / (t1 + t3 + t4), n as f64 / (t1 + tf));
+}

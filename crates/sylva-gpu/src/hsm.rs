@@ -1,0 +1,241 @@
+//! Hierarchical shape matching on the GPU (Song §5.2): the four stages as compute kernels
+//! over the same linearised buffers as the CPU ([`sylva_core::animate::hsm::HsmLayout`]),
+//! every substep of a step (and the pose) recorded into one command submission. The state
+//! stays on the GPU; read it back with [`GpuHsm::read_state`] or [`GpuHsm::read_pose`].
+//!
+//! Stage 1 `hsm_clusters` runs one 64-invocation workgroup per cluster with a shared-memory
+//! reduction; stage 2, the synchronisation, is the boundary between dispatches; stage 3
+//! `hsm_goals` and stage 4 `hsm_integrate` run one invocation per particle, or fused as
+//! `hsm_particles` ([`sylva_core::animate::hsm::HsmParams::fused`]). Each substep's
+//! parameters (its time) are copied into the step buffer by a copy command between
+//! substeps, so one submission carries every substep.
+
+use crate::kernel::{Kernel, output, upload};
+use crate::pose::GpuPose;
+use crate::shader::{HSM, HSM_CLUSTERS, HSM_GOALS, HSM_INTEGRATE, HSM_PARTICLES, HSM_POSE, NOISE, QUAT, TREE, WIND};
+use crate::{GpuContext, GpuError};
+use std::sync::Arc;
+use sylva_core::Tree;
+use sylva_core::animate::Pose;
+use sylva_core::animate::hsm::{Hsm, HsmState, RawHsmClusterState, RawHsmStep};
+use sylva_core::wind::WindScene;
+
+/// Song's four stages on the GPU for one [`Hsm`] (a tree or a forest of copies).
+#[derive(Debug)]
+pub struct GpuHsm {
+    clusters_kernel: Arc<Kernel>,
+    goals_kernel: Arc<Kernel>,
+    integrate_kernel: Arc<Kernel>,
+    particles_kernel: Arc<Kernel>,
+    fused: bool,
+    pose_kernel: Arc<Kernel>,
+    pose: Option<GpuPose>,
+    fields: wgpu::Buffer,
+    waves: wgpu::Buffer,
+    info: wgpu::Buffer,
+    clusters: wgpu::Buffer,
+    slots: wgpu::Buffer,
+    rest: wgpu::Buffer,
+    owner: wgpu::Buffer,
+    member_offset: wgpu::Buffer,
+    member: wgpu::Buffer,
+    segment_cluster: wgpu::Buffer,
+    /// The substep parameters of the current submission, one after another.
+    steps: wgpu::Buffer,
+    steps_capacity: usize,
+    step: wgpu::Buffer,
+    position: wgpu::Buffer,
+    velocity: wgpu::Buffer,
+    state: wgpu::Buffer,
+    goal: wgpu::Buffer,
+    n_clusters: usize,
+    n_particles: usize,
+    /// Simulated time, s.
+    pub time: f32,
+}
+
+/// Most substeps recorded into one submission by [`GpuHsm::advance`]; longer runs are split.
+pub const MAX_SUBSTEPS_PER_SUBMISSION: usize = 4096;
+
+impl GpuHsm {
+    /// Uploads the layout and the wind; the state starts at `method.rest_state()`. With a
+    /// `tree`, each step also writes the pose (the layout's segment clusters must be the
+    /// tree's); without one (a forest for benchmarks) only the particles are simulated.
+    pub fn new(ctx: &GpuContext, tree: Option<&Tree>, method: &Hsm, wind: &WindScene) -> Result<Self, GpuError> {
+        let l = &method.layout;
+        let (fields, waves) = wind.pack();
+        let (wind_fields, wind_waves) = crate::wind_sample::upload_wind(ctx, &fields, &waves)?;
+        let rest_state = method.rest_state();
+        let pose = match tree {
+            Some(t) => Some(GpuPose::new(ctx, t)?),
+            None => None,
+        };
+        let step = method.step_params(0.0, 0.0);
+        let this = Self {
+            clusters_kernel: Kernel::cached(ctx, "hsm_clusters", &[QUAT, NOISE, WIND, HSM, HSM_CLUSTERS]),
+            goals_kernel: Kernel::cached(ctx, "hsm_goals", &[QUAT, HSM, HSM_GOALS]),
+            integrate_kernel: Kernel::cached(ctx, "hsm_integrate", &[QUAT, HSM, HSM_INTEGRATE]),
+            particles_kernel: Kernel::cached(ctx, "hsm_particles", &[QUAT, HSM, HSM_PARTICLES]),
+            fused: method.params.fused,
+            pose_kernel: Kernel::cached(ctx, "hsm_pose", &[QUAT, TREE, HSM, HSM_POSE]),
+            pose,
+            fields: wind_fields,
+            waves: wind_waves,
+            info: upload(ctx, "hsm cluster info", &l.info)?,
+            clusters: upload(ctx, "hsm clusters", &l.clusters)?,
+            slots: upload(ctx, "hsm slots", &l.slots)?,
+            rest: upload(ctx, "hsm rest", &l.rest)?,
+            owner: upload(ctx, "hsm owners", &l.owner)?,
+            member_offset: upload(ctx, "hsm member offsets", &l.member_offset)?,
+            member: upload(ctx, "hsm members", &l.member)?,
+            segment_cluster: upload(ctx, "hsm segment clusters", &l.segment_cluster)?,
+            steps: upload(ctx, "hsm substeps", &vec![step; method.params.substeps as usize])?,
+            steps_capacity: method.params.substeps as usize,
+            step: upload(ctx, "hsm step", &[step])?,
+            position: upload(ctx, "hsm positions", &rest_state.position)?,
+            velocity: upload(ctx, "hsm velocities", &rest_state.velocity)?,
+            state: upload(ctx, "hsm cluster state", &rest_state.clusters)?,
+            goal: output::<[f32; 4]>(ctx, "hsm goals", l.rest.len())?,
+            n_clusters: l.info.len(),
+            n_particles: l.rest.len(),
+            time: 0.0,
+        };
+        ctx.queue.write_buffer(&this.goal, 0, bytemuck::cast_slice(&rest_state.goal));
+        // The rest pose, until the first step writes one.
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        this.record_pose(ctx, &mut e);
+        ctx.queue.submit([e.finish()]);
+        Ok(this)
+    }
+
+    /// Replaces the GPU state by `state` (for example a settled CPU state).
+    pub fn write_state(&mut self, ctx: &GpuContext, state: &HsmState) {
+        ctx.queue.write_buffer(&self.position, 0, bytemuck::cast_slice(&state.position));
+        ctx.queue.write_buffer(&self.velocity, 0, bytemuck::cast_slice(&state.velocity));
+        ctx.queue.write_buffer(&self.state, 0, bytemuck::cast_slice(&state.clusters));
+        ctx.queue.write_buffer(&self.goal, 0, bytemuck::cast_slice(&state.goal));
+        self.time = state.time;
+    }
+
+    /// Advances by one step of `dt` seconds in `method.params.substeps` substeps, all in one
+    /// submission (not waited for).
+    pub fn step(&mut self, ctx: &GpuContext, method: &Hsm, dt: f32) {
+        self.advance(ctx, method, dt, 1);
+    }
+
+    /// Advances by `steps` steps of `dt` seconds; every substep of up to
+    /// [`MAX_SUBSTEPS_PER_SUBMISSION`] goes into one submission, the pose is written once at
+    /// the end (not waited for).
+    pub fn advance(&mut self, ctx: &GpuContext, method: &Hsm, dt: f32, steps: usize) {
+        let n = method.params.substeps.max(1) as usize;
+        let h = dt / n as f32;
+        let total = steps * n;
+        let mut done = 0;
+        while done < total {
+            let batch = (total - done).min(MAX_SUBSTEPS_PER_SUBMISSION);
+            // Times accumulate substep by substep as on the CPU (`state.time + h`).
+            let params: Vec<RawHsmStep> = (0..batch)
+                .map(|_| {
+                    self.time += h;
+                    method.step_params(self.time, h)
+                })
+                .collect();
+            if batch > self.steps_capacity {
+                self.steps = output::<RawHsmStep>(ctx, "hsm substeps", batch).expect("substep parameters fit");
+                self.steps_capacity = batch;
+            }
+            ctx.queue.write_buffer(&self.steps, 0, bytemuck::cast_slice(&params));
+            let mut e = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hsm") });
+            for k in 0..batch {
+                self.record_substep(ctx, &mut e, k);
+            }
+            done += batch;
+            if done == total {
+                self.record_pose(ctx, &mut e);
+            }
+            ctx.queue.submit([e.finish()]);
+        }
+    }
+
+    fn record_substep(&self, ctx: &GpuContext, e: &mut wgpu::CommandEncoder, k: usize) {
+        let size = std::mem::size_of::<RawHsmStep>() as u64;
+        e.copy_buffer_to_buffer(&self.steps, k as u64 * size, &self.step, 0, size);
+        let lanes = sylva_core::cpu::hsm::LANES as u32;
+        self.clusters_kernel.record(
+            ctx,
+            e,
+            &[
+                &self.fields,
+                &self.waves,
+                &self.info,
+                &self.clusters,
+                &self.slots,
+                &self.position,
+                &self.rest,
+                &self.step,
+                &self.state,
+            ],
+            self.n_clusters as u32 * lanes,
+        );
+        if self.fused {
+            self.particles_kernel.record(
+                ctx,
+                e,
+                &[
+                    &self.member_offset,
+                    &self.member,
+                    &self.rest,
+                    &self.owner,
+                    &self.state,
+                    &self.step,
+                    &self.position,
+                    &self.velocity,
+                ],
+                self.n_particles as u32,
+            );
+            return;
+        }
+        self.goals_kernel.record(
+            ctx,
+            e,
+            &[&self.member_offset, &self.member, &self.rest, &self.state, &self.goal],
+            self.n_particles as u32,
+        );
+        self.integrate_kernel.record(
+            ctx,
+            e,
+            &[&self.rest, &self.owner, &self.state, &self.goal, &self.step, &self.position, &self.velocity],
+            self.n_particles as u32,
+        );
+    }
+
+    fn record_pose(&self, ctx: &GpuContext, e: &mut wgpu::CommandEncoder) {
+        if let Some(pose) = &self.pose {
+            self.pose_kernel.record(
+                ctx,
+                e,
+                &[&self.segment_cluster, &self.state, pose.acc_buffer()],
+                pose.segment_count() as u32,
+            );
+            pose.record_positions(ctx, e);
+        }
+    }
+
+    /// Reads the particle and cluster state back (waits for the GPU).
+    pub fn read_state(&self, ctx: &GpuContext) -> Result<HsmState, GpuError> {
+        use crate::kernel::read_back;
+        Ok(HsmState {
+            position: read_back(ctx, &self.position, self.n_particles)?,
+            velocity: read_back(ctx, &self.velocity, self.n_particles)?,
+            clusters: read_back::<RawHsmClusterState>(ctx, &self.state, self.n_clusters)?,
+            goal: read_back(ctx, &self.goal, self.n_particles)?,
+            time: self.time,
+        })
+    }
+
+    /// Reads the pose written by the last step back (waits for the GPU); `None` without a
+    /// tree.
+    pub fn read_pose(&self, ctx: &GpuContext) -> Result<Option<Pose>, GpuError> {
+        self.pose.as_ref().map(|p| p.read(ctx)).transpose()
+    }
+}

@@ -1,0 +1,96 @@
+// hsm_clusters (Song §5.2 stage 1): one workgroup per cluster, its particles as
+// invocations; centre of mass and Apq summed in shared memory (each invocation strides over
+// the slots, then a tree reduction), then one invocation extracts R, forms the goal
+// transform, α and the wind. CPU twin: sylva_core::cpu::hsm::hsm_clusters (same lanes, same
+// reduction tree). Bindings: 0 fields, 1 waves, 2 cluster info, 3 clusters, 4 slots,
+// 5 positions, 6 rest positions, 7 step, 8 cluster state.
+
+@group(0) @binding(2) var<storage, read> info: array<HsmClusterInfo>;
+@group(0) @binding(3) var<storage, read> clusters: array<HsmCluster>;
+@group(0) @binding(4) var<storage, read> slots: array<HsmSlot>;
+@group(0) @binding(5) var<storage, read> position: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> rest: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> step: HsmStep;
+@group(0) @binding(8) var<storage, read_write> state: array<HsmClusterState>;
+
+const LANES: u32 = 64u;
+
+var<workgroup> red_m: array<vec3<f32>, 64>;
+var<workgroup> red_a0: array<vec3<f32>, 64>;
+var<workgroup> red_a1: array<vec3<f32>, 64>;
+var<workgroup> red_a2: array<vec3<f32>, 64>;
+
+@compute @workgroup_size(64)
+fn main(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) t: u32,
+) {
+    let c = wg.x + wg.y * nwg.x;
+    if (c >= arrayLength(&info)) {
+        return;
+    }
+    let inf = info[c];
+    var sm = vec3<f32>(0.0);
+    var a0 = vec3<f32>(0.0);
+    var a1 = vec3<f32>(0.0);
+    var a2 = vec3<f32>(0.0);
+    for (var j = t; j < inf.slot_count; j += LANES) {
+        let s = slots[inf.slot_offset + j];
+        let x = position[s.particle];
+        let m = x.w;
+        let u = x.xyz - rest[s.particle].xyz;
+        let q = s.q;
+        sm += u * m;
+        let d = u + q;
+        a0 += (d * q.x) * m;
+        a1 += (d * q.y) * m;
+        a2 += (d * q.z) * m;
+    }
+    red_m[t] = sm;
+    red_a0[t] = a0;
+    red_a1[t] = a1;
+    red_a2[t] = a2;
+    workgroupBarrier();
+    for (var s = LANES / 2u; s > 0u; s >>= 1u) {
+        if (t < s) {
+            red_m[t] = red_m[t] + red_m[t + s];
+            red_a0[t] = red_a0[t] + red_a0[t + s];
+            red_a1[t] = red_a1[t] + red_a1[t + s];
+            red_a2[t] = red_a2[t] + red_a2[t + s];
+        }
+        workgroupBarrier();
+    }
+    if (t != 0u) {
+        return;
+    }
+    let cl = clusters[c];
+    let c0 = cl.rest_cm.xyz;
+    let shift = red_m[0] / cl.mass;
+    let cm = c0 + shift;
+    let apq = mat3x3<f32>(red_a0[0], red_a1[0], red_a2[0]);
+    let q = extract_rotation(apq, state[c].rotation, step.polar_iterations);
+    let r = quat_to_mat3(q);
+    var tr = r;
+    if (step.beta > 0.0) {
+        let aqq_inv = mat3x3<f32>(cl.aqq_inv[0].xyz, cl.aqq_inv[1].xyz, cl.aqq_inv[2].xyz);
+        let a = apq * aqq_inv;
+        let det = determinant(a);
+        if (det > 1e-6) {
+            tr = a * (step.beta / pow(det, 1.0 / 3.0)) + r * (1.0 - step.beta);
+        }
+    }
+    let alpha = min(cl.rest_cm.w * step.dt * step.dt, 1.0);
+    var u = vec3<f32>(0.0);
+    if (inf.kind != HSM_LEAF) {
+        u = wind_at(cm, step.time);
+    }
+    state[c].cm = vec4<f32>(cm, alpha);
+    state[c].rotation = q;
+    state[c].transform = array<vec4<f32>, 3>(
+        vec4<f32>(tr[0], shift.x),
+        vec4<f32>(tr[1], shift.y),
+        vec4<f32>(tr[2], shift.z),
+    );
+    state[c].wind = vec4<f32>(u, 0.0);
+}
