@@ -1,3 +1,7 @@
+//! Times each stage of hierarchical shape matching on the CPU at Song's largest Table 2 size
+//! (4,975 clusters of Quaking Aspen), or `N` copies of it: `cargo run --release -p sylva-core
+//! --example hsm_stages [N]`; `WIND=<preset or file>` picks the wind (default `gusty`).
+
 use std::time::Instant;
 use sylva_core::animate::hsm::*;
 use sylva_core::cpu::hsm::*;
