@@ -12,7 +12,9 @@
 
 use crate::kernel::{Kernel, output, upload};
 use crate::pose::GpuPose;
-use crate::shader::{HSM, HSM_CLUSTERS, HSM_GOALS, HSM_INTEGRATE, HSM_PARTICLES, HSM_POSE, NOISE, QUAT, TREE, WIND};
+use crate::shader::{
+    HSM, HSM_CLUSTERS, HSM_GATHER, HSM_GOALS, HSM_INTEGRATE, HSM_PARTICLES, HSM_POSE, NOISE, QUAT, TREE, WIND,
+};
 use crate::{GpuContext, GpuError};
 use std::sync::Arc;
 use sylva_core::Tree;
@@ -73,9 +75,9 @@ impl GpuHsm {
         let step = method.step_params(0.0, 0.0);
         let this = Self {
             clusters_kernel: Kernel::cached(ctx, "hsm_clusters", &[QUAT, NOISE, WIND, HSM, HSM_CLUSTERS]),
-            goals_kernel: Kernel::cached(ctx, "hsm_goals", &[QUAT, HSM, HSM_GOALS]),
+            goals_kernel: Kernel::cached(ctx, "hsm_goals", &[QUAT, HSM, HSM_GATHER, HSM_GOALS]),
             integrate_kernel: Kernel::cached(ctx, "hsm_integrate", &[QUAT, HSM, HSM_INTEGRATE]),
-            particles_kernel: Kernel::cached(ctx, "hsm_particles", &[QUAT, HSM, HSM_PARTICLES]),
+            particles_kernel: Kernel::cached(ctx, "hsm_particles", &[QUAT, HSM, HSM_GATHER, HSM_PARTICLES]),
             fused: method.params.fused,
             pose_kernel: Kernel::cached(ctx, "hsm_pose", &[QUAT, TREE, HSM, HSM_POSE]),
             pose,
@@ -185,8 +187,8 @@ impl GpuHsm {
                     &self.member_offset,
                     &self.member,
                     &self.rest,
-                    &self.owner,
                     &self.state,
+                    &self.owner,
                     &self.step,
                     &self.position,
                     &self.velocity,

@@ -210,15 +210,7 @@ pub fn hsm_integrate(
     position: &mut [[f32; 4]],
     velocity: &mut [[f32; 4]],
 ) {
-    position.par_iter_mut().zip(velocity.par_iter_mut()).enumerate().with_min_len(256).for_each(|(i, (x, v))| {
-        if v[3] == 0.0 {
-            return; // fixed
-        }
-        let p = a3(*x);
-        let vel = particle_velocity(a3(*v), goal[i], p, a3(state[owner[i] as usize].wind), rest[i][3], &step);
-        *x = with_xyz(p + vel * step.dt, x[3]);
-        *v = with_xyz(vel, v[3]);
-    });
+    integrate_free(rest, owner, state, step, position, velocity, |i| goal[i]);
 }
 
 /// Stages 3 and 4 in one pass per particle: its goal, gathered from its clusters, is read by
@@ -226,26 +218,42 @@ pub fn hsm_integrate(
 /// buffer (Song needs a synchronisation between the two because his goals are scattered
 /// from the clusters). The same operations as [`hsm_goals`] then [`hsm_integrate`], so the
 /// result is bit for bit theirs without the goal buffer's write and re-read. Bindings:
-/// 0 member offsets, 1 members, 2 rest (w = drag factor), 3 owners, 4 cluster state,
+/// 0 member offsets, 1 members, 2 rest (w = drag factor), 3 cluster state, 4 owners,
 /// 5 step, 6 positions, 7 velocities.
 #[allow(clippy::too_many_arguments)]
 pub fn hsm_particles(
     member_offset: &[u32],
     member: &[RawHsmMember],
     rest: &[[f32; 4]],
+    state: &[RawHsmClusterState],
+    owner: &[u32],
+    step: RawHsmStep,
+    position: &mut [[f32; 4]],
+    velocity: &mut [[f32; 4]],
+) {
+    integrate_free(rest, owner, state, step, position, velocity, |i| {
+        particle_goal(i, member_offset, member, rest, state)
+    });
+}
+
+/// Stage 4 over every free particle, its goal from `goal_of` (read from the goal buffer,
+/// or gathered in place by the fused pass).
+#[inline(always)]
+fn integrate_free(
+    rest: &[[f32; 4]],
     owner: &[u32],
     state: &[RawHsmClusterState],
     step: RawHsmStep,
     position: &mut [[f32; 4]],
     velocity: &mut [[f32; 4]],
+    goal_of: impl Fn(usize) -> [f32; 4] + Sync,
 ) {
     position.par_iter_mut().zip(velocity.par_iter_mut()).enumerate().with_min_len(256).for_each(|(i, (x, v))| {
         if v[3] == 0.0 {
             return; // fixed
         }
-        let g = particle_goal(i, member_offset, member, rest, state);
         let p = a3(*x);
-        let vel = particle_velocity(a3(*v), g, p, a3(state[owner[i] as usize].wind), rest[i][3], &step);
+        let vel = particle_velocity(a3(*v), goal_of(i), p, a3(state[owner[i] as usize].wind), rest[i][3], &step);
         *x = with_xyz(p + vel * step.dt, x[3]);
         *v = with_xyz(vel, v[3]);
     });

@@ -1,14 +1,10 @@
 // hsm_particles: stages 3 and 4 in one pass per particle (its goal is read by no other
 // particle, so it skips the goal buffer). The same operations as hsm_goals then
 // hsm_integrate. CPU twin: sylva_core::cpu::hsm::hsm_particles. Bindings: 0 member offsets,
-// 1 members, 2 rest (w = drag factor), 3 owners, 4 cluster state, 5 step, 6 positions,
-// 7 velocities.
+// 1 members, 2 rest (w = drag factor), 3 cluster state (from hsm_gather.wgsl), 4 owners,
+// 5 step, 6 positions, 7 velocities.
 
-@group(0) @binding(0) var<storage, read> member_offset: array<u32>;
-@group(0) @binding(1) var<storage, read> member: array<HsmMember>;
-@group(0) @binding(2) var<storage, read> rest: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read> owner: array<u32>;
-@group(0) @binding(4) var<storage, read> state: array<HsmClusterState>;
+@group(0) @binding(4) var<storage, read> owner: array<u32>;
 @group(0) @binding(5) var<storage, read> step: HsmStep;
 @group(0) @binding(6) var<storage, read_write> position: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read_write> velocity: array<vec4<f32>>;
@@ -23,21 +19,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if (v0.w == 0.0) {
         return;
     }
-    var sum = vec3<f32>(0.0);
-    var wsum = 0.0;
-    for (var k = member_offset[i]; k < member_offset[i + 1u]; k++) {
-        let m = member[k];
-        let st = state[m.cluster];
-        sum += hsm_goal_displacement(st, m.q) * st.cm.w;
-        wsum += st.cm.w;
-    }
-    let x0 = rest[i].xyz;
-    var g = vec4<f32>(x0, 0.0);
-    if (wsum > 0.0) {
-        g = vec4<f32>(x0 + sum / wsum, min(wsum, 1.0));
-    }
     let x = position[i];
-    let vel = hsm_velocity(v0.xyz, g, x.xyz, state[owner[i]].wind.xyz, rest[i].w, step);
+    let vel = hsm_velocity(v0.xyz, hsm_particle_goal(i), x.xyz, state[owner[i]].wind.xyz, rest[i].w, step);
     position[i] = vec4<f32>(x.xyz + vel * step.dt, x.w);
     velocity[i] = vec4<f32>(vel, v0.w);
 }

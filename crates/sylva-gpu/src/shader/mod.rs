@@ -39,6 +39,8 @@ pub const SKJERMO_ROTATIONS: &str = include_str!("skjermo_rotations.wgsl");
 pub const HSM: &str = include_str!("hsm.wgsl");
 /// Kernel: HSM stage 1, per cluster (workgroup reduction).
 pub const HSM_CLUSTERS: &str = include_str!("hsm_clusters.wgsl");
+/// Stage 3's per-particle gather (`hsm_particle_goal`), shared by two kernels.
+pub const HSM_GATHER: &str = include_str!("hsm_gather.wgsl");
 /// Kernel: HSM stage 3, per-particle goals.
 pub const HSM_GOALS: &str = include_str!("hsm_goals.wgsl");
 /// Kernel: HSM stage 4, per-particle integration.
@@ -65,9 +67,9 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("skjermo_step", &[QUAT, TREE, NOISE, WIND, SKJERMO, SKJERMO_STEP]),
     ("skjermo_rotations", &[QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS]),
     ("hsm_clusters", &[QUAT, NOISE, WIND, HSM, HSM_CLUSTERS]),
-    ("hsm_goals", &[QUAT, HSM, HSM_GOALS]),
+    ("hsm_goals", &[QUAT, HSM, HSM_GATHER, HSM_GOALS]),
     ("hsm_integrate", &[QUAT, HSM, HSM_INTEGRATE]),
-    ("hsm_particles", &[QUAT, HSM, HSM_PARTICLES]),
+    ("hsm_particles", &[QUAT, HSM, HSM_GATHER, HSM_PARTICLES]),
     ("hsm_pose", &[QUAT, TREE, HSM, HSM_POSE]),
 ];
 
