@@ -19,6 +19,7 @@ pub mod export;
 pub mod generate;
 pub mod io;
 pub mod limits;
+pub mod mesh;
 pub mod model;
 pub mod rng;
 pub mod species;

@@ -60,6 +60,11 @@ pub struct GpuHsm {
 pub const MAX_SUBSTEPS_PER_SUBMISSION: usize = 4096;
 
 impl GpuHsm {
+    /// The pose seam's buffers on the GPU, when built with the tree.
+    pub fn gpu_pose(&self) -> Option<&GpuPose> {
+        self.pose.as_ref()
+    }
+
     /// Uploads the layout and the wind; the state starts at `method.rest_state()`. With a
     /// `tree`, each step also writes the pose (the layout's segment clusters must be the
     /// tree's); without one (a forest for benchmarks) only the particles are simulated.

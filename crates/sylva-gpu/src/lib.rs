@@ -14,6 +14,7 @@
 mod context;
 pub mod hsm;
 pub mod kernel;
+pub mod mesh;
 pub mod pose;
 pub mod segment_ends;
 pub mod shader;

@@ -148,6 +148,11 @@ impl GpuPose {
         self.positions.record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, &self.joints], total);
     }
 
+    /// The buffer of posed joint positions (w = 0), instance-major.
+    pub fn joints_buffer(&self) -> &wgpu::Buffer {
+        &self.joints
+    }
+
     /// The buffer of accumulated (world) rotations D.
     pub fn acc_buffer(&self) -> &wgpu::Buffer {
         &self.acc
@@ -211,6 +216,11 @@ pub struct GpuZioma {
 }
 
 impl GpuZioma {
+    /// The pose seam's buffers on the GPU (for meshing without a round trip).
+    pub fn gpu_pose(&self) -> &GpuPose {
+        &self.pose
+    }
+
     /// Uploads the tree, Zioma's per-stem constants and the wind scene.
     pub fn new(ctx: &GpuContext, tree: &Tree, method: &Zioma, wind: &WindScene) -> Result<Self, GpuError> {
         Self::with_instances(ctx, tree, method, wind, &[])
@@ -314,6 +324,11 @@ pub struct GpuAkagi {
 }
 
 impl GpuAkagi {
+    /// The pose seam's buffers on the GPU (for meshing without a round trip).
+    pub fn gpu_pose(&self) -> &GpuPose {
+        &self.pose
+    }
+
     /// Uploads the tree, Akagi's constants and the wind; the state starts at rest.
     pub fn new(
         ctx: &GpuContext,
@@ -431,6 +446,11 @@ pub struct GpuSkjermo {
 }
 
 impl GpuSkjermo {
+    /// The pose seam's buffers on the GPU (for meshing without a round trip).
+    pub fn gpu_pose(&self) -> &GpuPose {
+        &self.pose
+    }
+
     /// Uploads the tree, Skjermo's constants and the wind; the state starts at rest.
     pub fn new(
         ctx: &GpuContext,

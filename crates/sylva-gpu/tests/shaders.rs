@@ -346,3 +346,48 @@ fn hsm_structs_match_their_wgsl_twins() {
         ],
     );
 }
+
+#[test]
+fn mesh_structs_match_their_wgsl_twins() {
+    use sylva_core::mesh::{RawMeshInfo, RawRing, RawVertex};
+    use sylva_gpu::shader::{MESH, NOISE};
+    let src = compose(&[NOISE, MESH]);
+    check_in(
+        &src,
+        "Ring",
+        size_of::<RawRing>(),
+        &[
+            ("segment", offset_of!(RawRing, segment)),
+            ("prev", offset_of!(RawRing, prev)),
+            ("next", offset_of!(RawRing, next)),
+            ("t", offset_of!(RawRing, t)),
+            ("v", offset_of!(RawRing, v)),
+            ("relief", offset_of!(RawRing, relief)),
+            ("stem_seed", offset_of!(RawRing, stem_seed)),
+            ("radius", offset_of!(RawRing, radius)),
+        ],
+    );
+    check_in(
+        &src,
+        "MeshInfo",
+        size_of::<RawMeshInfo>(),
+        &[
+            ("sides", offset_of!(RawMeshInfo, sides)),
+            ("rings", offset_of!(RawMeshInfo, rings)),
+            ("leaf_sides", offset_of!(RawMeshInfo, leaf_sides)),
+            ("leaves", offset_of!(RawMeshInfo, leaves)),
+            ("_pad", offset_of!(RawMeshInfo, _pad)),
+        ],
+    );
+    check_in(
+        &src,
+        "Vertex",
+        size_of::<RawVertex>(),
+        &[
+            ("position", offset_of!(RawVertex, position)),
+            ("u", offset_of!(RawVertex, u)),
+            ("normal", offset_of!(RawVertex, normal)),
+            ("v", offset_of!(RawVertex, v)),
+        ],
+    );
+}

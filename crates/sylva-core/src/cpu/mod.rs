@@ -3,6 +3,8 @@
 
 pub mod akagi;
 pub mod hsm;
+mod mesh_leaves;
+mod mesh_tubes;
 pub mod noise;
 pub mod pose_fk;
 mod segment_ends;
@@ -11,6 +13,8 @@ pub mod trunk_noise;
 pub mod wind_sample;
 pub mod zioma_rotations;
 
+pub use mesh_leaves::mesh_leaves;
+pub use mesh_tubes::mesh_tubes;
 pub use segment_ends::segment_ends;
 pub use trunk_noise::trunk_noise;
 pub use wind_sample::wind_sample;

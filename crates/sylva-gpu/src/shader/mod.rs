@@ -49,6 +49,12 @@ pub const HSM_INTEGRATE: &str = include_str!("hsm_integrate.wgsl");
 pub const HSM_PARTICLES: &str = include_str!("hsm_particles.wgsl");
 /// Kernel: seam rotations from HSM's clusters.
 pub const HSM_POSE: &str = include_str!("hsm_pose.wgsl");
+/// Per-frame meshing structs (`Ring`, `MeshInfo`, `Vertex`) and the bark relief.
+pub const MESH: &str = include_str!("mesh.wgsl");
+/// Kernel: bark vertices of every tube.
+pub const MESH_TUBES: &str = include_str!("mesh_tubes.wgsl");
+/// Kernel: leaf-polygon vertices.
+pub const MESH_LEAVES: &str = include_str!("mesh_leaves.wgsl");
 /// Kernel: trunk noise bands at many (t, tree) samples.
 pub const TRUNK_NOISE: &str = include_str!("trunk_noise.wgsl");
 
@@ -71,6 +77,8 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("hsm_integrate", &[QUAT, HSM, HSM_INTEGRATE]),
     ("hsm_particles", &[QUAT, HSM, HSM_GATHER, HSM_PARTICLES]),
     ("hsm_pose", &[QUAT, TREE, HSM, HSM_POSE]),
+    ("mesh_tubes", &[QUAT, TREE, NOISE, MESH, MESH_TUBES]),
+    ("mesh_leaves", &[QUAT, TREE, NOISE, MESH, MESH_LEAVES]),
 ];
 
 /// Concatenates WGSL sources into one module.

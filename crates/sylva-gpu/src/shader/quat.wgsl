@@ -35,3 +35,20 @@ fn quat_from_rotation_vector(t: vec3<f32>) -> vec4<f32> {
     }
     return quat_axis_angle(t / a, a);
 }
+
+// Spherical linear interpolation along the shorter arc; nlerp when nearly equal.
+// CPU twin: sylva_core::mesh::quat_slerp.
+fn quat_slerp(a: vec4<f32>, b_in: vec4<f32>, t: f32) -> vec4<f32> {
+    var d = dot(a, b_in);
+    var b = b_in;
+    if (d < 0.0) {
+        d = -d;
+        b = -b;
+    }
+    if (d > 0.9995) {
+        return normalize(a * (1.0 - t) + b * t);
+    }
+    let theta = acos(d);
+    let s = 1.0 / sin(theta);
+    return normalize(a * (sin((1.0 - t) * theta) * s) + b * (sin(t * theta) * s));
+}

@@ -1,0 +1,345 @@
+//! Geometry every frame (Akagi & Kitajima §2.2–2.4, §3): tubes around the posed skeleton and
+//! a polygon per leaf, regenerated from the pose each frame with a fixed topology.
+//!
+//! # Tubes (§2.2)
+//! Every stem is one tube. Each segment contributes `samples` cross-sections along a cubic
+//! **Hermite centreline** between its posed end points; the tangents at a joint are the
+//! normalised mean of the two segments' axes there (scaled by the segment length), so the
+//! centreline is C¹ through joints. A cross-section is the unit n-gon (`sides`, 8 by
+//! default) placed at the centreline point, oriented by the **slerp** of the joint frames at
+//! the segment's ends (a joint's frame is the half-way slerp of the two segments meeting
+//! there) and sized by the linear interpolation of base and tip radius. The last ring of one
+//! segment *is* the first ring of the next (one ring per joint), so the surface is continuous
+//! by construction and normals and bark texture coordinates run on along the stem:
+//! `u` around (0…1, a duplicated seam column), `v` = rest arc length / (2π × the stem's base
+//! radius), so bark texels stay square.
+//!
+//! # Displacement (§2.3)
+//! On segments thicker than [`MeshParams::displace_min_radius`] ring vertices are pushed
+//! along their normal by a procedural bark relief (ridges along the stem broken by noise),
+//! periodic around the stem so the seam stays closed, and zero at the stem's base and tip
+//! rings so joints with parents stay closed.
+//!
+//! # Leaves (§2.4)
+//! From each leaf point a leaf polygon: the unit n-gon as two half-circles scaled by the
+//! blade's width and length (an ellipse from the attachment point to the tip), fanned from
+//! its centre, carried by its segment's rotation.
+//!
+//! # Data
+//! The topology (index buffers, the ring table) is built once per tree by [`MeshLayout`];
+//! per frame only vertices are computed, from the pose as the GPU pose seam stores it
+//! (joint positions and accumulated rotations `D`, see [`crate::animate`]). The CPU
+//! references `cpu::mesh_tubes` and `cpu::mesh_leaves` are the twins of
+//! `sylva-gpu`'s `mesh_tubes.wgsl` and `mesh_leaves.wgsl` (one invocation per vertex).
+
+use crate::animate::Pose;
+use crate::model::{NONE, RawLeaf, RawSegment, Tree};
+use bytemuck::{Pod, Zeroable};
+use glam::Quat;
+
+/// Meshing parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeshParams {
+    /// Sides of each tube cross-section. Default 8, Akagi's choice: round enough at a few
+    /// pixels across, 16 triangles per ring segment.
+    pub sides: u32,
+    /// Cross-sections per segment (≥ 1). Default 3: enough for the Hermite curve to read
+    /// as a bend at joints without multiplying vertices.
+    pub samples: u32,
+    /// Sides of the leaf polygon. Default 8 (four per half-circle).
+    pub leaf_sides: u32,
+    /// Mesh the leaves.
+    pub leaves: bool,
+    /// Bark relief depth as a fraction of the local radius. Default 0.06: visible ridges on
+    /// a trunk without changing its silhouette much. 0 turns displacement off.
+    pub bark_depth: f32,
+    /// Segments with a base radius below this (m) are not displaced. Default 0.04 m: the
+    /// trunk and thick branches.
+    pub displace_min_radius: f32,
+}
+
+impl Default for MeshParams {
+    fn default() -> Self {
+        Self { sides: 8, samples: 3, leaf_sides: 8, leaves: true, bark_depth: 0.06, displace_min_radius: 0.04 }
+    }
+}
+
+/// Largest sides / samples accepted (bounds memory on user input).
+pub const MAX_SIDES: u32 = 64;
+/// Smallest ring radius as a fraction of its stem's base radius.
+pub const MIN_RADIUS_FRACTION: f32 = 0.1;
+/// Largest samples per segment accepted.
+pub const MAX_SAMPLES: u32 = 32;
+
+/// One cross-section of a tube, 32 bytes. WGSL: `struct Ring` in `mesh.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawRing {
+    /// Segment the ring lies on.
+    pub segment: u32,
+    /// Previous segment of the same stem ([`NONE`] at the stem's base).
+    pub prev: u32,
+    /// Next segment of the same stem ([`NONE`] at the stem's tip).
+    pub next: u32,
+    /// Parameter along the segment, 0…1.
+    pub t: f32,
+    /// Bark texture coordinate along the stem.
+    pub v: f32,
+    /// Bark relief depth, fraction of the radius (0 = not displaced).
+    pub relief: f32,
+    /// Seed of the stem's relief pattern.
+    pub stem_seed: u32,
+    /// Rest radius of the ring, m: base-to-tip interpolation on the segment, never below
+    /// [`MIN_RADIUS_FRACTION`] of the stem's base radius (a stem ending in a point would
+    /// give degenerate triangles).
+    pub radius: f32,
+}
+
+/// Frame constants, 32 bytes. WGSL: `struct MeshInfo` in `mesh.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawMeshInfo {
+    /// Tube sides.
+    pub sides: u32,
+    /// Number of rings.
+    pub rings: u32,
+    /// Leaf polygon sides.
+    pub leaf_sides: u32,
+    /// Number of leaves.
+    pub leaves: u32,
+    /// Padding.
+    pub _pad: [u32; 4],
+}
+
+/// One output vertex, 32 bytes: position and `u`, normal and `v`. WGSL: `struct Vertex` in
+/// `mesh.wgsl`; the renderer draws the buffer the kernels write as it is.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawVertex {
+    /// Position, m.
+    pub position: [f32; 3],
+    /// Texture coordinate u.
+    pub u: f32,
+    /// Unit normal.
+    pub normal: [f32; 3],
+    /// Texture coordinate v.
+    pub v: f32,
+}
+
+/// The fixed topology of one tree's mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshLayout {
+    /// Parameters it was built with.
+    pub params: MeshParams,
+    /// Ring table (per stem, base to tip).
+    pub rings: Vec<RawRing>,
+    /// Bark triangle indices into the tube vertices.
+    pub tube_indices: Vec<u32>,
+    /// Leaf triangle indices into the leaf vertices.
+    pub leaf_indices: Vec<u32>,
+    /// Packed segments (rest data the kernels read).
+    pub segments: Vec<RawSegment>,
+    /// Packed leaves.
+    pub leaves: Vec<RawLeaf>,
+}
+
+/// One frame's vertices.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshFrame {
+    /// Bark vertices (`rings × (sides + 1)`).
+    pub tubes: Vec<RawVertex>,
+    /// Leaf vertices (`leaves × (leaf_sides + 1)`).
+    pub leaves: Vec<RawVertex>,
+}
+
+/// Errors building a mesh layout.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    /// A parameter is out of range.
+    #[error("mesh parameter `{field}` = {value}: expected {expected}")]
+    Param { field: &'static str, value: String, expected: &'static str },
+    /// The mesh would be too large.
+    #[error("the mesh would have {vertices} vertices; the limit is {limit} (lower `sides`/`samples` or the tree size)")]
+    TooLarge { vertices: u64, limit: u64 },
+}
+
+/// Largest number of vertices of one mesh (tubes or leaves): indices are u32 and a GPU
+/// storage binding holds 128 MiB on the smallest device Sylva supports (4 Mi × 32 B).
+pub const MAX_VERTICES: u64 = 4 << 20;
+
+impl MeshLayout {
+    /// Builds the topology for `tree`.
+    pub fn new(tree: &Tree, params: MeshParams) -> Result<Self, MeshError> {
+        let bad = |field, value: String, expected| Err(MeshError::Param { field, value, expected });
+        if !(3..=MAX_SIDES).contains(&params.sides) {
+            return bad("sides", params.sides.to_string(), "3 to 64");
+        }
+        if !(1..=MAX_SAMPLES).contains(&params.samples) {
+            return bad("samples", params.samples.to_string(), "1 to 32");
+        }
+        if !(3..=MAX_SIDES).contains(&params.leaf_sides) {
+            return bad("leaf_sides", params.leaf_sides.to_string(), "3 to 64");
+        }
+        if !(params.bark_depth.is_finite() && (0.0..=0.5).contains(&params.bark_depth)) {
+            return bad("bark_depth", params.bark_depth.to_string(), "0 to 0.5");
+        }
+        let s = &tree.segments;
+        let st = &tree.stems;
+        let ring_count: u64 = st.segment_count.iter().map(|&n| n as u64 * params.samples as u64 + 1).sum();
+        let tube_vertices = ring_count * (params.sides as u64 + 1);
+        let leaf_vertices = if params.leaves { tree.leaves.len() as u64 * (params.leaf_sides as u64 + 1) } else { 0 };
+        for v in [tube_vertices, leaf_vertices] {
+            if v > MAX_VERTICES {
+                return Err(MeshError::TooLarge { vertices: v, limit: MAX_VERTICES });
+            }
+        }
+        let mut rings = Vec::with_capacity(ring_count as usize);
+        let mut tube_indices = Vec::new();
+        let sides = params.sides;
+        for k in 0..st.len() {
+            let first = st.first_segment[k] as usize;
+            let n = st.segment_count[k] as usize;
+            let base_radius = s.radius_base[first].max(1e-4);
+            let v_scale = 1.0 / (std::f32::consts::TAU * base_radius);
+            let first_ring = rings.len() as u32;
+            let mut arc = 0.0f32;
+            for i in first..first + n {
+                let prev = if i > first { (i - 1) as u32 } else { NONE };
+                let next = if i + 1 < first + n { (i + 1) as u32 } else { NONE };
+                let relief = if s.radius_base[i] >= params.displace_min_radius { params.bark_depth } else { 0.0 };
+                let last_j = if next == NONE { params.samples } else { params.samples - 1 };
+                for j in 0..=last_j {
+                    let t = j as f32 / params.samples as f32;
+                    // No relief on the stem's first and last rings: they meet the parent
+                    // and close the tip.
+                    let edge = (i == first && j == 0) || (next == NONE && j == params.samples);
+                    rings.push(RawRing {
+                        segment: i as u32,
+                        prev,
+                        next,
+                        t,
+                        v: (arc + t * s.length[i]) * v_scale,
+                        relief: if edge { 0.0 } else { relief },
+                        stem_seed: (k as u32).wrapping_mul(0x9e37_79b9) ^ tree.seed as u32,
+                        radius: (s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * t)
+                            .max(MIN_RADIUS_FRACTION * base_radius),
+                    });
+                }
+                arc += s.length[i];
+            }
+            let ring_end = rings.len() as u32;
+            let stride = sides + 1;
+            for r in first_ring..ring_end - 1 {
+                for j in 0..sides {
+                    let a = r * stride + j;
+                    let b = a + 1;
+                    let c = a + stride;
+                    let d = c + 1;
+                    tube_indices.extend_from_slice(&[a, c, d, a, d, b]);
+                }
+            }
+        }
+        let mut leaf_indices = Vec::new();
+        if params.leaves {
+            let stride = params.leaf_sides + 1;
+            for l in 0..tree.leaves.len() as u32 {
+                let c = l * stride;
+                for j in 0..params.leaf_sides {
+                    let a = c + 1 + j;
+                    let b = c + 1 + (j + 1) % params.leaf_sides;
+                    leaf_indices.extend_from_slice(&[c, a, b]);
+                }
+            }
+        }
+        Ok(Self {
+            params,
+            rings,
+            tube_indices,
+            leaf_indices,
+            segments: tree.raw_segments(),
+            leaves: if params.leaves { tree.raw_leaves() } else { Vec::new() },
+        })
+    }
+
+    /// Frame constants for the kernels.
+    pub fn info(&self) -> RawMeshInfo {
+        RawMeshInfo {
+            sides: self.params.sides,
+            rings: self.rings.len() as u32,
+            leaf_sides: self.params.leaf_sides,
+            leaves: self.leaves.len() as u32,
+            _pad: [0; 4],
+        }
+    }
+
+    /// Number of bark vertices.
+    pub fn tube_vertex_count(&self) -> usize {
+        self.rings.len() * (self.params.sides as usize + 1)
+    }
+
+    /// Number of leaf vertices.
+    pub fn leaf_vertex_count(&self) -> usize {
+        self.leaves.len() * (self.params.leaf_sides as usize + 1)
+    }
+
+    /// Number of triangles (bark + leaves).
+    pub fn triangle_count(&self) -> usize {
+        (self.tube_indices.len() + self.leaf_indices.len()) / 3
+    }
+
+    /// The mesh of `pose`, on the CPU (rayon).
+    pub fn mesh(&self, tree: &Tree, pose: &Pose) -> MeshFrame {
+        let (joint, acc) = pose_buffers(tree, pose);
+        self.mesh_raw(&joint, &acc)
+    }
+
+    /// The mesh from the pose seam's buffers (joint positions, accumulated rotations D).
+    pub fn mesh_raw(&self, joint: &[[f32; 4]], acc: &[[f32; 4]]) -> MeshFrame {
+        let info = self.info();
+        let mut tubes = vec![RawVertex::zeroed(); self.tube_vertex_count()];
+        crate::cpu::mesh_tubes(&info, &self.rings, &self.segments, joint, acc, &mut tubes);
+        let mut leaves = vec![RawVertex::zeroed(); self.leaf_vertex_count()];
+        crate::cpu::mesh_leaves(&info, &self.leaves, &self.segments, joint, acc, &mut leaves);
+        MeshFrame { tubes, leaves }
+    }
+}
+
+/// A pose as the GPU pose seam stores it: joint positions (w = 0) and accumulated
+/// rotations `D = Q · Q_rest⁻¹`.
+pub fn pose_buffers(tree: &Tree, pose: &Pose) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    let joint = pose.start.iter().map(|p| p.extend(0.0).to_array()).collect();
+    let acc = pose
+        .orientation
+        .iter()
+        .zip(&tree.segments.orientation)
+        .map(|(q, r)| (*q * r.conjugate()).normalize().to_array())
+        .collect();
+    (joint, acc)
+}
+
+/// Spherical linear interpolation of unit quaternions along the shorter arc; nlerp when
+/// they are nearly equal. The WGSL twin is `quat_slerp` in `quat.wgsl`.
+pub fn quat_slerp(a: Quat, b: Quat, t: f32) -> Quat {
+    let mut d = a.dot(b);
+    let mut b = b;
+    if d < 0.0 {
+        d = -d;
+        b = -b;
+    }
+    if d > 0.9995 {
+        return (a * (1.0 - t) + b * t).normalize();
+    }
+    let theta = d.acos();
+    let s = 1.0 / theta.sin();
+    (a * (((1.0 - t) * theta).sin() * s) + b * ((t * theta).sin() * s)).normalize()
+}
+
+/// Bark relief in −1…1 at angle fraction `u` (periodic) and height `v` along the stem.
+/// The WGSL twin is `bark_relief` in `mesh.wgsl`.
+pub fn bark_relief(u: f32, v: f32, seed: u32) -> f32 {
+    // Seven ridges around the stem (an integer count keeps the relief periodic in u),
+    // wandering sideways with height by 1-D noise along v.
+    let wander = crate::cpu::noise::value_noise(v * 0.6, seed);
+    let ridge = (std::f32::consts::TAU * (u * 7.0 + 0.8 * wander)).sin();
+    ridge * ridge * 2.0 - 1.0
+}

@@ -1,0 +1,178 @@
+//! Per-frame meshing (Akagi §2.2–2.4) on the CPU: topology, watertight joints, unit normals,
+//! no degenerate triangles, leaves where their points are.
+
+use glam::{Quat, Vec3};
+use rand::{Rng, SeedableRng};
+use sylva_core::Tree;
+use sylva_core::animate::Pose;
+use sylva_core::mesh::{MeshError, MeshFrame, MeshLayout, MeshParams, RawVertex};
+use sylva_core::species::{PRESETS, SpeciesSource};
+
+fn tree(name: &str) -> Tree {
+    SpeciesSource::resolve(name).unwrap().generate(3, &Default::default(), None).unwrap()
+}
+
+/// A pose with small random rotations at every joint (seeded).
+fn random_pose(t: &Tree, seed: u64, angle: f32) -> Pose {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let delta: Vec<[f32; 4]> = (0..t.segments.len())
+        .map(|_| {
+            let axis = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            Quat::from_axis_angle(axis.normalize_or(Vec3::X), rng.random_range(-angle..angle)).to_array()
+        })
+        .collect();
+    Pose::from_rotations(t, &delta)
+}
+
+fn pos(v: &RawVertex) -> Vec3 {
+    Vec3::from_array(v.position)
+}
+
+/// The checks every mesh must pass (the "watertight tubes" list).
+fn check_mesh(t: &Tree, pose: &Pose, layout: &MeshLayout, m: &MeshFrame, what: &str) {
+    let h = t.height();
+    let sides = layout.params.sides as usize;
+    let stride = sides + 1;
+    assert_eq!(m.tubes.len(), layout.tube_vertex_count());
+    assert_eq!(m.leaves.len(), layout.leaf_vertex_count());
+    for (i, v) in m.tubes.iter().chain(&m.leaves).enumerate() {
+        let n = Vec3::from_array(v.normal);
+        assert!(pos(v).is_finite(), "{what}: vertex {i} not finite");
+        assert!((n.length() - 1.0).abs() < 1e-4, "{what}: vertex {i} normal length {}", n.length());
+    }
+    // The seam column duplicates the first: same position and normal, u = 1 vs 0.
+    for r in 0..layout.rings.len() {
+        let (a, b) = (&m.tubes[r * stride], &m.tubes[r * stride + sides]);
+        assert_eq!(a.position, b.position, "{what}: ring {r} seam open");
+        assert_eq!((a.u, b.u), (0.0, 1.0));
+    }
+    // Rings at joints: the ring shared by two segments is centred on the posed joint, which
+    // is where the previous segment's tube ends (its posed end point).
+    let params_no_relief = layout.params.bark_depth == 0.0;
+    for (r, ring) in layout.rings.iter().enumerate() {
+        if ring.t != 0.0 {
+            continue;
+        }
+        let i = ring.segment as usize;
+        let centre: Vec3 = (0..sides).map(|k| pos(&m.tubes[r * stride + k])).sum::<Vec3>() / sides as f32;
+        let target = if ring.prev != sylva_core::NONE { pose.end(t, ring.prev as usize) } else { pose.start[i] };
+        let tol = 2e-5 * h;
+        if params_no_relief || ring.relief == 0.0 {
+            assert!(
+                (centre - target).length() <= tol,
+                "{what}: ring {r} of segment {i} centred {} from its joint (tol {tol})",
+                (centre - target).length()
+            );
+        }
+    }
+    // No degenerate triangles: every triangle has area (relative to its longest edge²).
+    for (verts, idx, kind) in [(&m.tubes, &layout.tube_indices, "bark"), (&m.leaves, &layout.leaf_indices, "leaf")] {
+        for (f, tri) in idx.chunks(3).enumerate() {
+            let [a, b, c] = [0, 1, 2].map(|j| pos(&verts[tri[j] as usize]));
+            let area2 = (b - a).cross(c - a).length();
+            let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+            assert!(area2 > 1e-6 * longest * longest, "{what}: {kind} triangle {f} degenerate");
+        }
+    }
+}
+
+#[test]
+fn topology_counts_follow_the_layout() {
+    let t = tree("black_tupelo");
+    let p = MeshParams::default();
+    let l = MeshLayout::new(&t, p).unwrap();
+    let rings: usize = t.stems.segment_count.iter().map(|&n| n as usize * p.samples as usize + 1).sum();
+    assert_eq!(l.rings.len(), rings);
+    assert_eq!(l.tube_vertex_count(), rings * (p.sides as usize + 1));
+    assert_eq!(l.tube_indices.len(), (rings - t.stems.len()) * p.sides as usize * 6);
+    assert_eq!(l.leaf_indices.len(), t.leaves.len() * p.leaf_sides as usize * 3);
+    assert!(l.tube_indices.iter().all(|&i| (i as usize) < l.tube_vertex_count()));
+    assert!(l.leaf_indices.iter().all(|&i| (i as usize) < l.leaf_vertex_count()));
+    let no_leaves = MeshLayout::new(&t, MeshParams { leaves: false, ..p }).unwrap();
+    assert_eq!(no_leaves.leaf_vertex_count(), 0);
+}
+
+#[test]
+fn every_preset_meshes_watertight_at_rest_and_posed() {
+    for preset in PRESETS {
+        let t = tree(preset.name);
+        for (k, pose) in [Pose::rest(&t), random_pose(&t, 7, 0.15)].iter().enumerate() {
+            let flat = MeshLayout::new(&t, MeshParams { bark_depth: 0.0, ..Default::default() }).unwrap();
+            check_mesh(&t, pose, &flat, &flat.mesh(&t, pose), &format!("{} pose {k}", preset.name));
+            let bark = MeshLayout::new(&t, MeshParams::default()).unwrap();
+            check_mesh(&t, pose, &bark, &bark.mesh(&t, pose), &format!("{} pose {k} with relief", preset.name));
+        }
+    }
+}
+
+#[test]
+fn tubes_follow_the_radius_and_relief_stays_within_its_depth() {
+    let t = tree("quaking_aspen");
+    let pose = Pose::rest(&t);
+    for depth in [0.0, 0.06] {
+        let l = MeshLayout::new(&t, MeshParams { bark_depth: depth, ..Default::default() }).unwrap();
+        let m = l.mesh(&t, &pose);
+        let stride = l.params.sides as usize + 1;
+        let mut displaced = 0;
+        for (r, ring) in l.rings.iter().enumerate() {
+            let s = ring.segment as usize;
+            let lerp = t.segments.radius_base[s] + (t.segments.radius_tip[s] - t.segments.radius_base[s]) * ring.t;
+            let radius = ring.radius;
+            assert!(radius >= lerp && radius > 0.0, "ring {r}: radius {radius} below the segment's {lerp}");
+            let centre: Vec3 =
+                (0..stride - 1).map(|k| pos(&m.tubes[r * stride + k])).sum::<Vec3>() / (stride - 1) as f32;
+            for k in 0..stride - 1 {
+                let d = (pos(&m.tubes[r * stride + k]) - centre).length();
+                let allowed = radius * (1.0 + 1.01 * ring.relief) + 1e-5;
+                assert!(d <= allowed, "ring {r}: vertex {k} at {d} m from the centre, radius {radius}");
+                if (d - radius).abs() > 1e-3 * radius + 1e-5 {
+                    displaced += 1;
+                }
+            }
+        }
+        assert_eq!(displaced > 0, depth > 0.0, "relief depth {depth}: {displaced} displaced vertices");
+    }
+}
+
+#[test]
+fn leaves_hang_where_their_points_are_and_move_with_their_segment() {
+    let t = tree("quaking_aspen");
+    let l = MeshLayout::new(&t, MeshParams::default()).unwrap();
+    let stride = l.params.leaf_sides as usize + 1;
+    let rest = l.mesh(&t, &Pose::rest(&t));
+    for i in (0..t.leaves.len()).step_by(97) {
+        let c = pos(&rest.leaves[i * stride]);
+        let want = t.leaves.position[i] + t.leaves.orientation[i] * Vec3::new(0.0, 0.5 * t.leaves.length[i], 0.0);
+        assert!((c - want).length() < 1e-5, "leaf {i} centre");
+        // The first rim vertex is the attachment point; the opposite one is the tip.
+        assert!((pos(&rest.leaves[i * stride + 1]) - t.leaves.position[i]).length() < 1e-5);
+        let n = Vec3::from_array(rest.leaves[i * stride].normal);
+        assert!((n - t.leaves.orientation[i] * Vec3::Z).length() < 1e-5);
+    }
+    // Rigidly rotating the whole tree about its root rotates every leaf with it.
+    let q = Quat::from_rotation_z(0.3);
+    let mut delta = vec![[0.0, 0.0, 0.0, 1.0]; t.segments.len()];
+    delta[0] = q.to_array();
+    let posed = l.mesh(&t, &Pose::from_rotations(&t, &delta));
+    let root = t.segments.start[0];
+    for (a, b) in rest.leaves.iter().zip(&posed.leaves).step_by(31) {
+        let want = root + q * (pos(a) - root);
+        assert!((pos(b) - want).length() < 1e-4, "leaf vertex did not follow its segment");
+    }
+}
+
+#[test]
+fn bad_parameters_are_refused_with_the_field_named() {
+    let t = tree("palm");
+    for (p, field) in [
+        (MeshParams { sides: 2, ..Default::default() }, "sides"),
+        (MeshParams { samples: 0, ..Default::default() }, "samples"),
+        (MeshParams { leaf_sides: 1000, ..Default::default() }, "leaf_sides"),
+        (MeshParams { bark_depth: f32::NAN, ..Default::default() }, "bark_depth"),
+    ] {
+        match MeshLayout::new(&t, p) {
+            Err(e @ MeshError::Param { .. }) => assert!(e.to_string().contains(field), "{e}"),
+            other => panic!("{field}: expected a parameter error, got {other:?}"),
+        }
+    }
+}

@@ -1,0 +1,63 @@
+// mesh_tubes: one bark vertex per invocation (Akagi §2.2–2.3): Hermite centreline, slerped
+// ring frame, interpolated radius, bark relief along the normal.
+// CPU twin: sylva_core::cpu::mesh_tubes (same bindings, same loop body).
+
+@group(0) @binding(0) var<storage, read> info: MeshInfo;
+@group(0) @binding(1) var<storage, read> ring: array<Ring>;
+@group(0) @binding(2) var<storage, read> segment: array<Segment>;
+@group(0) @binding(3) var<storage, read> joint: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> acc: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> vertex: array<Vertex>;
+
+fn world_orientation(i: u32) -> vec4<f32> {
+    return quat_mul(acc[i], segment[i].orientation);
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let vid = gid.x + gid.y * nwg.x * 64u;
+    let stride = info.sides + 1u;
+    if (vid >= info.rings * stride) {
+        return;
+    }
+    let rg = ring[vid / stride];
+    let k = vid % stride;
+    let i = rg.segment;
+    let seg = segment[i];
+    let q = world_orientation(i);
+    let axis = quat_rotate(q, vec3<f32>(0.0, 1.0, 0.0));
+    let p0 = joint[i].xyz;
+    let p1 = p0 + axis * seg.length;
+    var f0 = q;
+    var m0 = axis * seg.length;
+    if (rg.prev != NONE) {
+        let qp = world_orientation(rg.prev);
+        f0 = quat_slerp(qp, q, 0.5);
+        m0 = normalize(quat_rotate(qp, vec3<f32>(0.0, 1.0, 0.0)) + axis) * seg.length;
+    }
+    var f1 = q;
+    var m1 = axis * seg.length;
+    if (rg.next != NONE) {
+        let qn = world_orientation(rg.next);
+        f1 = quat_slerp(q, qn, 0.5);
+        m1 = normalize(axis + quat_rotate(qn, vec3<f32>(0.0, 1.0, 0.0))) * seg.length;
+    }
+    let t = rg.t;
+    let t2 = t * t;
+    let t3 = t2 * t;
+    let centre = p0 * (2.0 * t3 - 3.0 * t2 + 1.0)
+        + m0 * (t3 - 2.0 * t2 + t)
+        + p1 * (-2.0 * t3 + 3.0 * t2)
+        + m1 * (t3 - t2);
+    let frame = quat_slerp(f0, f1, t);
+    let radius = rg.radius;
+    let kk = k % info.sides;
+    let around = f32(kk) / f32(info.sides);
+    let angle = TAU * around;
+    let radial = quat_rotate(frame, vec3<f32>(cos(angle), 0.0, sin(angle)));
+    let slope = (seg.radius_base - seg.radius_tip) / max(seg.length, 1e-6);
+    let normal = normalize(radial + quat_rotate(frame, vec3<f32>(0.0, 1.0, 0.0)) * slope);
+    let relief = rg.relief * radius * bark_relief(around, rg.v, rg.stem_seed);
+    let p = centre + radial * radius + normal * relief;
+    vertex[vid] = Vertex(p, f32(k) / f32(info.sides), normal, rg.v);
+}

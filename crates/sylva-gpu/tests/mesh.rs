@@ -1,0 +1,91 @@
+//! Per-frame meshing: GPU (`mesh_tubes.wgsl`, `mesh_leaves.wgsl`) vs the CPU reference on
+//! every preset and random poses, and meshing straight from a GPU method's pose buffers.
+
+mod common;
+
+use glam::{Quat, Vec3};
+use rand::{Rng, SeedableRng};
+use sylva_core::Tree;
+use sylva_core::animate::Pose;
+use sylva_core::animate::zioma::{Zioma, ZiomaParams};
+use sylva_core::mesh::{MeshFrame, MeshLayout, MeshParams};
+use sylva_core::species::{PRESETS, SpeciesSource};
+use sylva_core::wind::WindScene;
+use sylva_gpu::mesh::GpuMesh;
+use sylva_gpu::pose::GpuZioma;
+
+fn random_pose(t: &Tree, rng: &mut rand::rngs::StdRng) -> Pose {
+    let delta: Vec<[f32; 4]> = (0..t.segments.len())
+        .map(|_| {
+            let axis = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            Quat::from_axis_angle(axis.normalize_or(Vec3::X), rng.random_range(-0.2..0.2)).to_array()
+        })
+        .collect();
+    Pose::from_rotations(t, &delta)
+}
+
+/// The bounds: same counts, positions within 1e-5 × tree height, normals within
+/// 1e-3, texture coordinates within 1e-5. Returns the worst position difference / height.
+fn compare(t: &Tree, cpu: &MeshFrame, gpu: &MeshFrame, what: &str) -> f32 {
+    let h = t.height();
+    assert_eq!(cpu.tubes.len(), gpu.tubes.len(), "{what}: bark vertex count");
+    assert_eq!(cpu.leaves.len(), gpu.leaves.len(), "{what}: leaf vertex count");
+    let mut worst = 0.0f32;
+    for (k, (a, b)) in cpu.tubes.iter().zip(&gpu.tubes).chain(cpu.leaves.iter().zip(&gpu.leaves)).enumerate() {
+        let d = (Vec3::from_array(a.position) - Vec3::from_array(b.position)).length();
+        worst = worst.max(d / h);
+        assert!(d <= 1e-5 * h, "{what}: vertex {k} {:?} vs {:?}", a.position, b.position);
+        let dn = (Vec3::from_array(a.normal) - Vec3::from_array(b.normal)).length();
+        assert!(dn <= 1e-3, "{what}: vertex {k} normal {:?} vs {:?}", a.normal, b.normal);
+        assert!((a.u - b.u).abs() <= 1e-5 && (a.v - b.v).abs() <= 1e-5 * a.v.abs().max(1.0), "{what}: vertex {k} uv");
+    }
+    worst
+}
+
+#[test]
+fn gpu_mesh_matches_cpu_on_every_preset_and_random_poses() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(2026);
+    for preset in PRESETS {
+        let t = SpeciesSource::resolve(preset.name).unwrap().generate(2, &Default::default(), None).unwrap();
+        let params = MeshParams {
+            sides: rng.random_range(5..12),
+            samples: rng.random_range(1..4),
+            leaf_sides: rng.random_range(4..10),
+            ..Default::default()
+        };
+        let layout = MeshLayout::new(&t, params).unwrap();
+        let gpu = GpuMesh::new(ctx, &layout).unwrap();
+        let pose = random_pose(&t, &mut rng);
+        let worst = compare(&t, &layout.mesh(&t, &pose), &gpu.mesh(ctx, &t, &pose).unwrap(), preset.name);
+        println!(
+            "mesh {}: {} vertices, worst {worst:.1e} × height",
+            preset.name,
+            layout.tube_vertex_count() + layout.leaf_vertex_count()
+        );
+    }
+}
+
+#[test]
+fn gpu_mesh_reads_a_gpu_methods_pose_without_a_round_trip() {
+    let Some(ctx) = common::gpu() else { return };
+    let t = SpeciesSource::resolve("sassafras").unwrap().generate(4, &Default::default(), None).unwrap();
+    let wind = WindScene::resolve("gusty").unwrap();
+    let method = Zioma::new(&t, ZiomaParams::default());
+    let g = GpuZioma::new(ctx, &t, &method, &wind).unwrap();
+    let layout = MeshLayout::new(&t, MeshParams::default()).unwrap();
+    let mesh = GpuMesh::new(ctx, &layout).unwrap();
+    for time in [0.7f32, 3.1] {
+        g.submit(ctx, &t, &method, time);
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        mesh.record(ctx, &mut e, g.gpu_pose().joints_buffer(), g.gpu_pose().acc_buffer());
+        ctx.queue.submit([e.finish()]);
+        let on_gpu = mesh.read(ctx).unwrap();
+        let pose = g.gpu_pose().read(ctx).unwrap();
+        let worst = compare(&t, &layout.mesh(&t, &pose), &on_gpu, &format!("zioma t = {time}"));
+        println!("zioma t = {time}: worst {worst:.1e} × height");
+        // The wind moved it: not the rest mesh.
+        let rest = layout.mesh(&t, &Pose::rest(&t));
+        assert!(rest.tubes.iter().zip(&on_gpu.tubes).any(|(a, b)| a.position != b.position));
+    }
+}
