@@ -1,9 +1,9 @@
 //! `sylva`: grow trees and move them in the wind.
 //!
-//! With no arguments, runs the main job on the built-in default scene. Until the renderer
-//! lands that is `sylva generate` on the default species.
+//! With no arguments, runs the main job: `sylva render` on the built-in default scene.
 
 mod bench_cmd;
+mod render_cmd;
 mod simulate_cmd;
 mod wind_cmd;
 
@@ -33,6 +33,9 @@ enum Command {
     Wind(wind_cmd::WindArgs),
     /// Animate a tree in the wind and report how it moved (optionally a CSV trajectory).
     Simulate(simulate_cmd::SimulateArgs),
+    /// Render a scene (the built-in default when none is given) to a GIF, PNG frames and,
+    /// with ffmpeg installed, an MP4.
+    Render(render_cmd::RenderArgs),
     /// Reproduce a paper's result table on the CPU and the GPU, with plots.
     Bench(bench_cmd::BenchArgs),
 }
@@ -68,10 +71,8 @@ struct GenerateArgs {
 fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
-        None => match Cli::parse_from(["sylva", "generate"]).command {
-            Some(Command::Generate(args)) => generate(args),
-            _ => unreachable!("`generate` parses as the generate command"),
-        },
+        None => render_cmd::run(&render_cmd::RenderArgs::default()),
+        Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Generate(args)) => generate(args),
         Some(Command::Presets) => {
             presets();

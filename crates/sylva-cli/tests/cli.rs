@@ -23,14 +23,106 @@ fn presets_lists_every_shipped_preset() {
     assert!(!out.contains("invalid"));
 }
 
+/// The main job (`sylva` with no arguments is `sylva render` on the default scene), made
+/// small by overrides: every default tree and method, a GIF and PNG frames.
 #[test]
-fn no_arguments_runs_the_default_job() {
+fn render_default_scene_writes_gif_and_frames() {
     let dir = tempfile::tempdir().unwrap();
-    let (ok, out, err) = sylva(dir.path(), &[]);
-    assert!(ok, "{err}");
-    assert!(out.contains("Quaking Aspen") && out.contains("segments"), "{out}");
-    let obj = std::fs::read_to_string(dir.path().join("out/quaking_aspen.obj")).unwrap();
-    assert!(obj.lines().filter(|l| l.starts_with("f ")).count() > 10_000);
+    let (ok, out, err) = sylva(
+        dir.path(),
+        &["render", "--width", "160", "--height", "90", "--seconds", "0.2", "--fps", "10", "--no-mp4"],
+    );
+    assert!(ok, "{err}\n{out}");
+    for m in ["zioma", "akagi", "skjermo", "hsm"] {
+        assert!(out.contains(&format!("· {m}")), "{m} missing:\n{out}");
+    }
+    let gif = dir.path().join("out/render/sylva.gif");
+    let decoder =
+        image::codecs::gif::GifDecoder::new(std::io::BufReader::new(std::fs::File::open(&gif).unwrap())).unwrap();
+    use image::AnimationDecoder;
+    let frames = decoder.into_frames().collect_frames().unwrap();
+    assert_eq!(frames.len(), 2);
+    assert_eq!(frames[0].buffer().dimensions(), (160, 90));
+    for f in 0..2 {
+        let png = image::open(dir.path().join(format!("out/render/frames/sylva_{f:04}.png"))).unwrap();
+        assert_eq!((png.width(), png.height()), (160, 90));
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path().join("out/render"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}
+
+const TINY_SCENE: &str = r#"
+[output]
+dir = "out"
+name = "tiny"
+width = 64
+height = 48
+fps = 100
+seconds = 20
+preroll = 0
+sim_rate = 100
+mp4 = false
+labels = false
+
+[[tree]]
+species = "palm"
+method = "zioma"
+"#;
+
+#[test]
+fn render_rejects_bad_scenes_naming_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("unknown.toml"), TINY_SCENE.replace("fps = 100", "fps = 100\nfsp = 3")).unwrap();
+    let (ok, _, err) = sylva(dir.path(), &["render", "unknown.toml"]);
+    assert!(!ok && err.contains("unknown.toml:8") && err.contains("fsp"), "{err}");
+    std::fs::write(dir.path().join("missing.toml"), TINY_SCENE.replace("\"palm\"", "\"baobab\"")).unwrap();
+    let (ok, _, err) = sylva(dir.path(), &["render", "missing.toml"]);
+    assert!(!ok && err.contains("tree[0].species") && err.contains("baobab"), "{err}");
+    let (ok, _, err) = sylva(dir.path(), &["render", "no/such/scene.toml"]);
+    assert!(!ok && err.contains("no/such/scene.toml"), "{err}");
+    assert!(!dir.path().join("out").exists());
+}
+
+/// An interrupted render (Ctrl-C) stops cleanly: no GIF, no temporary files; the frames
+/// written so far are complete PNGs.
+#[cfg(unix)]
+#[test]
+fn interrupted_render_leaves_no_partial_output() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), TINY_SCENE).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .current_dir(dir.path())
+        .args(["render", "tiny.toml"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let third = dir.path().join("out/frames/tiny_0002.png");
+    let start = std::time::Instant::now();
+    while !third.exists() {
+        assert!(start.elapsed().as_secs() < 300, "no frames after 300 s");
+        assert!(child.try_wait().unwrap().is_none(), "render ended before it was interrupted");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let killed = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "an interrupted render must fail");
+    assert!(err.contains("interrupted"), "{err}");
+    assert!(!dir.path().join("out/tiny.gif").exists(), "a partial GIF was left");
+    for e in std::fs::read_dir(dir.path().join("out"))
+        .unwrap()
+        .chain(std::fs::read_dir(dir.path().join("out/frames")).unwrap())
+    {
+        let name = e.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(!name.contains(".tmp"), "temporary file {name} left");
+    }
+    image::open(&third).expect("frames written before the interrupt are complete");
 }
 
 #[test]

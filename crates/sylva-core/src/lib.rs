@@ -22,6 +22,7 @@ pub mod limits;
 pub mod mesh;
 pub mod model;
 pub mod rng;
+pub mod scene;
 pub mod species;
 pub mod wind;
 

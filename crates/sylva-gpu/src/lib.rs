@@ -1,4 +1,4 @@
-//! Sylva's GPU crate: wgpu device setup, compute kernels and (later) the renderer.
+//! Sylva's GPU crate: wgpu device setup, compute kernels and the renderer.
 //!
 //! Every kernel here is the WGSL twin of a CPU reference in `sylva-core` with the same name,
 //! binding order and loop shape (`shader/x.wgsl` ↔ `sylva_core::cpu::x`), and tests hold the
@@ -16,6 +16,7 @@ pub mod hsm;
 pub mod kernel;
 pub mod mesh;
 pub mod pose;
+pub mod render;
 pub mod segment_ends;
 pub mod shader;
 pub mod trunk_noise;

@@ -1,0 +1,564 @@
+//! `sylva render`: the main job. Grows every tree of a scene, animates each with its method
+//! (CPU or GPU), meshes every frame on the GPU, renders it (sun, shadows, sky, ground,
+//! instancing) and writes a GIF, PNG frames and, when `ffmpeg` is installed, an MP4 — each
+//! file complete or not at all.
+
+use anyhow::{Context, Result, bail};
+use glam::{Mat4, Quat, Vec3};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+use sylva_core::animate::Pose;
+use sylva_core::animate::akagi::{Akagi, AkagiParams, AkagiState};
+use sylva_core::animate::hsm::{Hsm, HsmParams, HsmState};
+use sylva_core::animate::skjermo::{Skjermo, SkjermoParams, SkjermoState};
+use sylva_core::animate::zioma::{Zioma, ZiomaParams};
+use sylva_core::mesh::{MeshLayout, MeshParams};
+use sylva_core::scene::{BackendChoice, MethodName, Scene};
+use sylva_core::species::SpeciesSource;
+use sylva_core::wind::WindScene;
+use sylva_core::wind::raw::{RawField, RawWave};
+use sylva_core::{Limits, Tree};
+use sylva_gpu::GpuContext;
+use sylva_gpu::mesh::GpuMesh;
+use sylva_gpu::render::{Camera, DrawItem, Instance, Lighting, RenderSettings, Renderer};
+
+/// Arguments of `sylva render`.
+#[derive(clap::Args, Debug, Default)]
+pub struct RenderArgs {
+    /// Scene file (TOML); the built-in default scene when absent.
+    pub scene: Option<PathBuf>,
+    /// Output directory (overrides the scene's).
+    #[arg(long)]
+    pub out_dir: Option<PathBuf>,
+    /// Image width (overrides the scene's).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height (overrides the scene's).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Duration, s (overrides the scene's).
+    #[arg(long)]
+    pub seconds: Option<f32>,
+    /// Frames per second (overrides the scene's).
+    #[arg(long)]
+    pub fps: Option<f32>,
+    /// Where every tree's simulation runs (overrides each tree's `backend`).
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendArg>,
+    /// Write no MP4 even when ffmpeg is installed.
+    #[arg(long)]
+    pub no_mp4: bool,
+    /// Write no PNG frames.
+    #[arg(long)]
+    pub no_png: bool,
+}
+
+/// Backend override.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BackendArg {
+    /// GPU on hardware adapters, CPU on software rasterisers.
+    Auto,
+    /// CPU reference.
+    Cpu,
+    /// GPU kernels.
+    Gpu,
+}
+
+/// One tree's animation, on the CPU or the GPU.
+enum Anim {
+    ZiomaCpu(Zioma),
+    ZiomaGpu(Zioma, sylva_gpu::pose::GpuZioma),
+    AkagiCpu(Akagi, Box<AkagiState>),
+    AkagiGpu(sylva_gpu::pose::GpuAkagi),
+    SkjermoCpu(Skjermo, Box<SkjermoState>),
+    SkjermoGpu(sylva_gpu::pose::GpuSkjermo),
+    HsmCpu(Box<Hsm>, Box<HsmState>),
+    HsmGpu(Box<Hsm>, sylva_gpu::hsm::GpuHsm),
+}
+
+impl Anim {
+    fn new(ctx: &GpuContext, tree: &Tree, method: MethodName, gpu: bool, seed: u64, wind: &WindScene) -> Result<Self> {
+        Ok(match (method, gpu) {
+            (MethodName::Zioma, false) => Self::ZiomaCpu(Zioma::new(tree, ZiomaParams { seed, ..Default::default() })),
+            (MethodName::Zioma, true) => {
+                let m = Zioma::new(tree, ZiomaParams { seed, ..Default::default() });
+                let g = sylva_gpu::pose::GpuZioma::new(ctx, tree, &m, wind)?;
+                Self::ZiomaGpu(m, g)
+            }
+            (MethodName::Akagi, false) => {
+                let m = Akagi::new(tree, AkagiParams::default());
+                let s = m.rest_state(tree);
+                Self::AkagiCpu(m, Box::new(s))
+            }
+            (MethodName::Akagi, true) => {
+                let m = Akagi::new(tree, AkagiParams::default());
+                Self::AkagiGpu(sylva_gpu::pose::GpuAkagi::new(ctx, tree, &m, wind)?)
+            }
+            (MethodName::Skjermo, false) => {
+                let m = Skjermo::new(tree, SkjermoParams::default());
+                let s = m.rest_state(tree);
+                Self::SkjermoCpu(m, Box::new(s))
+            }
+            (MethodName::Skjermo, true) => {
+                let m = Skjermo::new(tree, SkjermoParams::default());
+                Self::SkjermoGpu(sylva_gpu::pose::GpuSkjermo::new(ctx, tree, &m, wind)?)
+            }
+            (MethodName::Hsm, false) => {
+                let m = Hsm::new(tree, HsmParams::default())?;
+                let s = m.rest_state();
+                Self::HsmCpu(Box::new(m), Box::new(s))
+            }
+            (MethodName::Hsm, true) => {
+                let m = Hsm::new(tree, HsmParams::default())?;
+                let g = sylva_gpu::hsm::GpuHsm::new(ctx, Some(tree), &m, wind)?;
+                Self::HsmGpu(Box::new(m), g)
+            }
+        })
+    }
+
+    /// Advances `steps` steps of `dt` (stateful methods) to time `t` (Zioma), then records
+    /// the mesh of the new pose: from the GPU pose buffers, or from a CPU pose uploaded.
+    #[allow(clippy::too_many_arguments)]
+    fn advance_and_mesh(
+        &mut self,
+        ctx: &GpuContext,
+        tree: &Tree,
+        wind: (&[RawField], &[RawWave]),
+        t: f32,
+        dt: f32,
+        steps: usize,
+        mesh: &GpuMesh,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> Result<()> {
+        let (fields, waves) = wind;
+        let cpu_pose: Option<Pose> = match self {
+            Self::ZiomaCpu(m) => Some(m.pose_packed(tree, fields, waves, t)),
+            Self::ZiomaGpu(m, g) => {
+                g.submit(ctx, tree, m, t);
+                None
+            }
+            Self::AkagiCpu(m, s) => {
+                for _ in 0..steps {
+                    m.step(tree, fields, waves, s, dt);
+                }
+                Some(s.pose.clone())
+            }
+            Self::AkagiGpu(g) => {
+                for _ in 0..steps {
+                    g.step(ctx, dt);
+                }
+                None
+            }
+            Self::SkjermoCpu(m, s) => {
+                for _ in 0..steps {
+                    m.step(tree, fields, waves, s, dt);
+                }
+                Some(s.pose.clone())
+            }
+            Self::SkjermoGpu(g) => {
+                for _ in 0..steps {
+                    g.step(ctx, dt);
+                }
+                None
+            }
+            Self::HsmCpu(m, s) => {
+                for _ in 0..steps {
+                    m.step(fields, waves, s, dt);
+                }
+                Some(m.pose(tree, s))
+            }
+            Self::HsmGpu(m, g) => {
+                g.advance(ctx, m, dt, steps);
+                None
+            }
+        };
+        match cpu_pose {
+            Some(pose) => mesh.record_pose(ctx, encoder, tree, &pose),
+            None => {
+                let pose = match self {
+                    Self::ZiomaGpu(_, g) => g.gpu_pose(),
+                    Self::AkagiGpu(g) => g.gpu_pose(),
+                    Self::SkjermoGpu(g) => g.gpu_pose(),
+                    Self::HsmGpu(_, g) => g.gpu_pose().context("HSM on the GPU was built without its tree")?,
+                    _ => unreachable!("CPU methods return a pose"),
+                };
+                mesh.record(ctx, encoder, pose.joints_buffer(), pose.acc_buffer());
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A temporary file renamed into place on success and removed otherwise.
+struct Pending {
+    tmp: PathBuf,
+    path: PathBuf,
+    done: bool,
+}
+
+impl Pending {
+    fn new(path: &Path) -> Self {
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        // The extension is kept last: encoders pick the format from it.
+        let ext = path.extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
+        let tmp = path.with_file_name(format!(".{name}.tmp-{}.{ext}", std::process::id()));
+        Self { tmp, path: path.to_path_buf(), done: false }
+    }
+
+    fn commit(mut self) -> Result<()> {
+        std::fs::rename(&self.tmp, &self.path).with_context(|| format!("writing {}", self.path.display()))?;
+        self.done = true;
+        Ok(())
+    }
+}
+
+impl Drop for Pending {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+fn instance(position: [f32; 3], yaw_deg: f32, scale: f32, tint: Vec3) -> Instance {
+    Instance {
+        transform: Mat4::from_scale_rotation_translation(
+            Vec3::splat(scale),
+            Quat::from_rotation_y(yaw_deg.to_radians()),
+            Vec3::from_array(position),
+        ),
+        tint,
+    }
+}
+
+fn ffmpeg_available() -> bool {
+    std::process::Command::new("ffmpeg")
+        .arg("-version")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// Draws labels (white on a dark shadow) onto an RGBA image.
+fn draw_labels(rgba: &mut [u8], w: u32, h: u32, labels: &[(String, f32, f32)]) -> Result<()> {
+    use plotters::prelude::*;
+    use plotters::style::text_anchor::{HPos, Pos, VPos};
+    let mut rgb: Vec<u8> = rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        let size = (h as f64 / 30.0).clamp(10.0, 40.0);
+        for (text, x, y) in labels {
+            let (x, y) = (*x as i32, *y as i32);
+            let pos = Pos::new(HPos::Center, VPos::Top);
+            for (dx, c) in [(1, RGBColor(20, 20, 20)), (0, RGBColor(250, 250, 245))] {
+                let style = TextStyle::from(("sans-serif", size).into_font()).color(&c).pos(pos);
+                root.draw(&Text::new(text.as_str(), (x + dx, y + dx), style))
+                    .map_err(|e| anyhow::anyhow!("drawing a label: {e}"))?;
+            }
+        }
+        root.present().map_err(|e| anyhow::anyhow!("drawing labels: {e}"))?;
+    }
+    for (d, s) in rgba.chunks_mut(4).zip(rgb.chunks(3)) {
+        d[..3].copy_from_slice(s);
+    }
+    Ok(())
+}
+
+/// Runs the command.
+pub fn run(a: &RenderArgs) -> Result<()> {
+    let mut scene = match &a.scene {
+        Some(p) => Scene::load(p)?,
+        None => Scene::default_scene(),
+    };
+    if let Some(d) = &a.out_dir {
+        scene.output.dir = d.clone();
+    }
+    if let Some(v) = a.width {
+        scene.output.width = v;
+    }
+    if let Some(v) = a.height {
+        scene.output.height = v;
+    }
+    if let Some(v) = a.seconds {
+        scene.output.seconds = v;
+    }
+    if let Some(v) = a.fps {
+        scene.output.fps = v;
+    }
+    if a.no_mp4 {
+        scene.output.mp4 = false;
+    }
+    if a.no_png {
+        scene.output.png = false;
+    }
+    if let Some(b) = a.backend {
+        for t in &mut scene.trees {
+            t.backend = match b {
+                BackendArg::Auto => BackendChoice::Auto,
+                BackendArg::Cpu => BackendChoice::Cpu,
+                BackendArg::Gpu => BackendChoice::Gpu,
+            };
+        }
+    }
+    scene.check().map_err(|(field, value, expected)| {
+        anyhow::anyhow!("{}: field `{field}` = {value}: expected {expected}", scene.file)
+    })?;
+    let interrupted = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupted.clone();
+        // A second handler cannot be installed (tests call `run` once per process).
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
+    render(&scene, &interrupted)
+}
+
+fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
+    let o = &scene.output;
+    let ctx = GpuContext::shared()?;
+    let software = ctx.summary.device_type == "Cpu";
+    println!("GPU: {}", ctx.summary);
+    let wind = WindScene::resolve(&scene.resolve_path(&scene.wind))
+        .with_context(|| format!("{}: field `wind`", scene.file))?;
+    let (fields, waves) = wind.pack();
+
+    struct Entry {
+        tree: Tree,
+        anim: Anim,
+        mesh: GpuMesh,
+        instances: wgpu::Buffer,
+        count: u32,
+        label: String,
+        base: Vec3,
+    }
+    let setup = Instant::now();
+    let mut entries = Vec::new();
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    let mut triangles = 0usize;
+    for (i, st) in scene.trees.iter().enumerate() {
+        let species = scene.resolve_path(&st.species);
+        let source =
+            SpeciesSource::resolve(&species).with_context(|| format!("{}: field `tree[{i}].species`", scene.file))?;
+        let tree = source.generate(st.seed, &Limits::default(), None)?;
+        let gpu = match st.backend {
+            BackendChoice::Auto => !software,
+            BackendChoice::Cpu => false,
+            BackendChoice::Gpu => true,
+        };
+        let anim = Anim::new(ctx, &tree, st.method, gpu, st.seed, &wind)?;
+        let defaults = MeshParams::default();
+        let params = MeshParams {
+            sides: st.sides.unwrap_or(defaults.sides),
+            leaf_sides: st.leaf_sides.unwrap_or(defaults.leaf_sides),
+            ..defaults
+        };
+        let layout = MeshLayout::new(&tree, params)?;
+        triangles += layout.triangle_count() * (1 + st.copies.len());
+        let mesh = GpuMesh::new(ctx, &layout)?;
+        let tint = Vec3::from_array(st.tint.unwrap_or([0.28, 0.50, 0.12]));
+        let mut inst = vec![instance(st.position, st.yaw_deg, st.scale, tint)];
+        inst.extend(st.copies.iter().map(|c| instance(c.position, c.yaw_deg, c.scale, tint * 1.05)));
+        let (tlo, thi) = tree.bounds();
+        for i in &inst {
+            for k in 0..8 {
+                let corner = Vec3::new(
+                    if k & 1 == 0 { tlo.x } else { thi.x },
+                    if k & 2 == 0 { tlo.y } else { thi.y },
+                    if k & 4 == 0 { tlo.z } else { thi.z },
+                );
+                let p = i.transform.transform_point3(corner);
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        let label = st.label.clone().unwrap_or_else(|| {
+            format!("{} · {} ({})", tree.name.replace('_', " "), st.method.as_str(), if gpu { "GPU" } else { "CPU" })
+        });
+        println!(
+            "  {:<18} {:>6} segments {:>7} leaves  {:>8} triangles × {} instance(s)  {}",
+            tree.name,
+            tree.segments.len(),
+            tree.leaves.len(),
+            layout.triangle_count(),
+            inst.len(),
+            label
+        );
+        let instances = Renderer::instances(ctx, &inst);
+        entries.push(Entry {
+            tree,
+            anim,
+            mesh,
+            instances,
+            count: inst.len() as u32,
+            label,
+            base: Vec3::from_array(st.position),
+        });
+    }
+    let renderer =
+        Renderer::new(ctx, RenderSettings { width: o.width, height: o.height, msaa: o.msaa, ..Default::default() })?;
+    let camera = Camera {
+        eye: Vec3::from_array(scene.camera.eye),
+        target: Vec3::from_array(scene.camera.target),
+        fov_y_deg: scene.camera.fov_deg,
+    };
+    let light = Lighting {
+        sun_direction: Vec3::from_array(scene.sun.direction).normalize(),
+        sun_intensity: scene.sun.intensity,
+        ..Default::default()
+    };
+    let globals = renderer.globals(&camera, &light, (lo, hi));
+    let view_proj = camera.view_proj(o.width as f32 / o.height as f32);
+    let labels: Vec<(String, f32, f32)> = if o.labels {
+        entries
+            .iter()
+            .enumerate()
+            .filter_map(|(k, e)| {
+                let c = view_proj * e.base.extend(1.0);
+                // Alternate rows so neighbours' labels do not overlap.
+                let row = (k % 2) as f32 * (o.height as f32 / 26.0).clamp(12.0, 44.0);
+                (c.w > 0.0).then(|| {
+                    let n = c.truncate() / c.w;
+                    let (x, y) = ((n.x * 0.5 + 0.5) * o.width as f32, (0.5 - n.y * 0.5) * o.height as f32);
+                    (e.label.clone(), x, y + 6.0 + row)
+                })
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    if o.labels {
+        let _ = plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, crate::wind_cmd::FONT);
+    }
+
+    std::fs::create_dir_all(&o.dir).with_context(|| format!("creating {}", o.dir.display()))?;
+    let frames_dir = o.dir.join("frames");
+    if o.png {
+        std::fs::create_dir_all(&frames_dir).with_context(|| format!("creating {}", frames_dir.display()))?;
+    }
+    let frames = scene.frames();
+    let steps = (o.sim_rate / o.fps).round().max(1.0) as usize;
+    let dt = 1.0 / (o.fps * steps as f32);
+    let gif_path = o.dir.join(format!("{}.gif", o.name));
+    let gif_pending = o.gif.then(|| Pending::new(&gif_path));
+    let mut gif = match &gif_pending {
+        Some(p) => {
+            let f = std::fs::File::create(&p.tmp).with_context(|| format!("creating {}", p.tmp.display()))?;
+            let mut enc = image::codecs::gif::GifEncoder::new_with_speed(std::io::BufWriter::new(f), 10);
+            enc.set_repeat(image::codecs::gif::Repeat::Infinite)?;
+            Some(enc)
+        }
+        None => None,
+    };
+    let mp4_path = o.dir.join(format!("{}.mp4", o.name));
+    let mp4_pending = (o.mp4 && ffmpeg_available()).then(|| Pending::new(&mp4_path));
+    let mut ffmpeg = match &mp4_pending {
+        Some(p) => Some(
+            std::process::Command::new("ffmpeg")
+                .args(["-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgba", "-s"])
+                .arg(format!("{}x{}", o.width, o.height))
+                .args(["-r", &o.fps.to_string(), "-i", "-", "-c:v", "libx264", "-pix_fmt", "yuv420p"])
+                .args(["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-movflags", "+faststart", "-f", "mp4"])
+                .arg(&p.tmp)
+                .stdin(std::process::Stdio::piped())
+                .spawn()
+                .context("starting ffmpeg")?,
+        ),
+        None => None,
+    };
+
+    // Pre-roll: stateful methods start at rest; let the wind move them first.
+    let preroll_steps = (o.preroll * o.fps * steps as f32).round() as usize;
+    let mut t = 0.0f32;
+    if preroll_steps > 0 {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        t = preroll_steps as f32 * dt;
+        for e in &mut entries {
+            e.anim.advance_and_mesh(ctx, &e.tree, (&fields, &waves), t, dt, preroll_steps, &e.mesh, &mut encoder)?;
+        }
+        ctx.queue.submit([encoder.finish()]);
+    }
+    println!("set up in {:.2} s; {} triangles per frame", setup.elapsed().as_secs_f64(), triangles);
+
+    let bar = ProgressBar::new(frames as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed} (eta {eta})").expect("valid template"),
+    );
+    let start = Instant::now();
+    let (mut sim_s, mut draw_s, mut encode_s) = (0.0f64, 0.0f64, 0.0f64);
+    for f in 0..frames {
+        if interrupted.load(Ordering::SeqCst) {
+            bar.abandon();
+            bail!("interrupted after {f} of {frames} frames; no partial animation was written");
+        }
+        let t0 = Instant::now();
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let advance = if f == 0 && preroll_steps > 0 { 0 } else { steps };
+        t += advance as f32 * dt;
+        for e in &mut entries {
+            e.anim.advance_and_mesh(ctx, &e.tree, (&fields, &waves), t, dt, advance, &e.mesh, &mut encoder)?;
+        }
+        let t1 = Instant::now();
+        let items: Vec<DrawItem<'_>> = entries
+            .iter()
+            .map(|e| DrawItem { mesh: &e.mesh, instances: &e.instances, instance_count: e.count })
+            .collect();
+        renderer.record(ctx, &mut encoder, &globals, &items);
+        let mut rgba = renderer.read_image(ctx, encoder)?;
+        let t2 = Instant::now();
+        draw_labels(&mut rgba, o.width, o.height, &labels)?;
+        let img = image::RgbaImage::from_raw(o.width, o.height, rgba).context("image size")?;
+        if o.png {
+            let path = frames_dir.join(format!("{}_{f:04}.png", o.name));
+            let p = Pending::new(&path);
+            img.save(&p.tmp).with_context(|| format!("writing {}", p.tmp.display()))?;
+            p.commit()?;
+        }
+        if let Some(enc) = &mut gif {
+            let delay = image::Delay::from_numer_denom_ms(1000, o.fps.round().max(1.0) as u32);
+            enc.encode_frame(image::Frame::from_parts(img.clone(), 0, 0, delay))?;
+        }
+        if let Some(child) = &mut ffmpeg {
+            child.stdin.as_mut().context("ffmpeg stdin")?.write_all(img.as_raw()).context("feeding ffmpeg")?;
+        }
+        sim_s += (t1 - t0).as_secs_f64();
+        draw_s += (t2 - t1).as_secs_f64();
+        encode_s += t2.elapsed().as_secs_f64();
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    if let Some(enc) = gif {
+        drop(enc);
+    }
+    if let Some(p) = gif_pending {
+        p.commit()?;
+        println!("wrote {}", gif_path.display());
+    }
+    if let (Some(mut child), Some(p)) = (ffmpeg, mp4_pending) {
+        drop(child.stdin.take());
+        let status = child.wait().context("waiting for ffmpeg")?;
+        if !status.success() {
+            bail!("ffmpeg failed ({status}); no MP4 written");
+        }
+        p.commit()?;
+        println!("wrote {}", mp4_path.display());
+    }
+    if o.png {
+        println!("wrote {} frames to {}", frames, frames_dir.display());
+    }
+    let n = frames as f64;
+    println!(
+        "{frames} frames of {}×{} in {:.2} s: {:.1} ms per frame (simulate + mesh recording {:.1}, GPU mesh + draw + readback {:.1}, labels + encoding {:.1})",
+        o.width,
+        o.height,
+        start.elapsed().as_secs_f64(),
+        1e3 * start.elapsed().as_secs_f64() / n,
+        1e3 * sim_s / n,
+        1e3 * draw_s / n,
+        1e3 * encode_s / n
+    );
+    Ok(())
+}

@@ -1,0 +1,109 @@
+//! The renderer: WGSL validated with naga, the uniform struct's layout, and a golden image
+//! of a small scene on this machine's adapter (lavapipe in CI).
+//!
+//! Golden images: `tests/golden/<name>.png`. A render passes when its mean absolute
+//! difference from the reference is below [`MEAN_TOLERANCE`] (0–255 scale) — tolerant of
+//! rasteriser rounding, not of a missing shadow or a wrong colour. `SYLVA_BLESS=1` rewrites
+//! the references; on failure `<name>.actual.png` and `<name>.diff.png` are written next to
+//! the reference.
+
+mod common;
+
+use glam::{Mat4, Vec3};
+use std::path::PathBuf;
+use sylva_core::animate::Pose;
+use sylva_core::mesh::{MeshLayout, MeshParams};
+use sylva_core::species::SpeciesSource;
+use sylva_gpu::mesh::GpuMesh;
+use sylva_gpu::render::{Camera, DrawItem, Instance, Lighting, RENDER_WGSL, RawGlobals, RenderSettings, Renderer};
+
+/// Largest mean absolute difference per channel (0–255) from the reference.
+const MEAN_TOLERANCE: f64 = 1.5;
+
+#[test]
+fn render_wgsl_validates_and_globals_match() {
+    let module =
+        naga::front::wgsl::parse_str(RENDER_WGSL).unwrap_or_else(|e| panic!("{}", e.emit_to_string(RENDER_WGSL)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(RENDER_WGSL)));
+    for entry in ["vs_sky", "fs_sky", "vs_ground", "fs_ground", "vs_tree", "fs_bark", "fs_leaf", "vs_shadow"] {
+        assert!(module.entry_points.iter().any(|e| e.name == entry), "no entry point {entry}");
+    }
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    let (handle, _) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some("Globals")).expect("Globals");
+    assert_eq!(layouter[handle].size as usize, std::mem::size_of::<RawGlobals>());
+}
+
+fn golden_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
+}
+
+/// Compares `rgba` with the stored reference `name` (see the module docs).
+fn check_golden(name: &str, w: u32, h: u32, rgba: &[u8]) {
+    let dir = golden_dir();
+    let reference = dir.join(format!("{name}.png"));
+    let actual = image::RgbaImage::from_raw(w, h, rgba.to_vec()).unwrap();
+    if std::env::var("SYLVA_BLESS").is_ok_and(|v| v == "1") {
+        actual.save(&reference).unwrap();
+        eprintln!("blessed {}", reference.display());
+        return;
+    }
+    let want = image::open(&reference)
+        .unwrap_or_else(|e| panic!("{}: {e} (run with SYLVA_BLESS=1 to create it)", reference.display()))
+        .to_rgba8();
+    assert_eq!(want.dimensions(), (w, h), "{name}: reference size");
+    let mut diff = image::RgbaImage::new(w, h);
+    let mut sum = 0u64;
+    for ((a, b), d) in actual.pixels().zip(want.pixels()).zip(diff.pixels_mut()) {
+        let e: [u8; 3] = [0, 1, 2].map(|c| a[c].abs_diff(b[c]));
+        sum += e.iter().map(|&x| x as u64).sum::<u64>();
+        *d = image::Rgba([e[0].saturating_mul(8), e[1].saturating_mul(8), e[2].saturating_mul(8), 255]);
+    }
+    let mean = sum as f64 / (w as f64 * h as f64 * 3.0);
+    if mean > MEAN_TOLERANCE {
+        actual.save(dir.join(format!("{name}.actual.png"))).unwrap();
+        diff.save(dir.join(format!("{name}.diff.png"))).unwrap();
+        panic!("{name}: mean difference {mean:.3} > {MEAN_TOLERANCE}; wrote {name}.actual.png and {name}.diff.png");
+    }
+    println!("{name}: mean difference {mean:.3} (tolerance {MEAN_TOLERANCE})");
+}
+
+#[test]
+fn small_scene_matches_its_golden_image() {
+    let Some(ctx) = common::gpu() else { return };
+    let t = SpeciesSource::resolve("palm").unwrap().generate(1, &Default::default(), None).unwrap();
+    let layout = MeshLayout::new(&t, MeshParams::default()).unwrap();
+    let mesh = GpuMesh::new(ctx, &layout).unwrap();
+    let (w, h) = (192u32, 128u32);
+    let renderer = Renderer::new(ctx, RenderSettings { width: w, height: h, msaa: 4, shadow_size: 512 }).unwrap();
+    let camera = Camera { eye: Vec3::new(2.0, 2.5, 9.0), target: Vec3::new(0.0, 2.2, 0.0), fov_y_deg: 45.0 };
+    let light = Lighting::default();
+    let tint = Vec3::new(0.25, 0.5, 0.1);
+    let instances = Renderer::instances(
+        ctx,
+        &[
+            Instance { transform: Mat4::IDENTITY, tint },
+            Instance { transform: Mat4::from_translation(Vec3::new(-4.0, 0.0, -5.0)), tint },
+        ],
+    );
+    let globals = renderer.globals(&camera, &light, (Vec3::new(-6.0, 0.0, -7.0), Vec3::new(3.0, 5.0, 3.0)));
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    mesh.record_pose(ctx, &mut encoder, &t, &Pose::rest(&t));
+    let items = [DrawItem { mesh: &mesh, instances: &instances, instance_count: 2 }];
+    renderer.record(ctx, &mut encoder, &globals, &items);
+    let rgba = renderer.read_image(ctx, encoder).unwrap();
+    assert_eq!(rgba.len(), (w * h * 4) as usize);
+
+    // The tree is there: the same frame without trees differs where the palm stands.
+    let empty = renderer.render(ctx, &globals, &[]).unwrap();
+    let changed = rgba.chunks(4).zip(empty.chunks(4)).filter(|(a, b)| a[..3] != b[..3]).count();
+    let fraction = changed as f64 / (w * h) as f64;
+    assert!(fraction > 0.03, "only {:.1} % of pixels show a tree", 100.0 * fraction);
+    // Sky above, ground below: the top row is bluer than it is green, the bottom row greener.
+    let px = |x: u32, y: u32| &rgba[((y * w + x) * 4) as usize..][..3];
+    assert!(px(2, 1)[2] > px(2, 1)[1], "sky is not blue: {:?}", px(2, 1));
+    assert!(px(2, h - 2)[1] > px(2, h - 2)[2], "ground is not green: {:?}", px(2, h - 2));
+    check_golden("small_scene", w, h, &rgba);
+}
