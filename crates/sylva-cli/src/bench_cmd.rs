@@ -25,6 +25,8 @@ pub enum Table {
     SongT2,
     /// Song et al. Table 3: ten trees, 50…49,750 clusters.
     SongT3,
+    /// Akagi & Kitajima Table 2: mesh regeneration, 108,808…4,109,056 triangles.
+    AkagiT2,
     /// Every table.
     All,
 }
@@ -144,9 +146,10 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
         bail!("--budget {budget}: expected a time budget in seconds, above 0 and at most 600");
     }
     let tables: &[Table] = match args.table {
-        Table::All => &[Table::SongT2, Table::SongT3],
+        Table::All => &[Table::SongT2, Table::SongT3, Table::AkagiT2],
         Table::SongT2 => &[Table::SongT2],
         Table::SongT3 => &[Table::SongT3],
+        Table::AkagiT2 => &[Table::AkagiT2],
     };
     let ctx = match args.backend {
         Backends::Cpu => None,
@@ -184,7 +187,11 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
     for &table in tables {
         let (name, title, rows, copies) = match table {
             Table::SongT2 => ("song-t2", "Song et al. Table 2: one tree", &SONG_TABLE_2, 1),
-            _ => ("song-t3", "Song et al. Table 3: ten trees", &SONG_TABLE_3, 10),
+            Table::SongT3 => ("song-t3", "Song et al. Table 3: ten trees", &SONG_TABLE_3, 10),
+            _ => {
+                written.extend(crate::bench_akagi::run(args.quick, budget, time_cpu, ctx, &args.out_dir)?);
+                continue;
+            }
         };
         let rows = if args.quick { &rows[..3] } else { &rows[..] };
         let bar = ProgressBar::new(rows.len() as u64).with_style(
@@ -251,7 +258,7 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
 
 /// Times `f(n)` (n steps): one warm-up call, a step count that makes a sample about a fifth
 /// of `budget`, then samples until the budget is spent (at least 3, at most 15).
-fn measure(budget: f64, mut f: impl FnMut(usize) -> Result<()>) -> Result<Rate> {
+pub(crate) fn measure(budget: f64, mut f: impl FnMut(usize) -> Result<()>) -> Result<Rate> {
     let t0 = Instant::now();
     f(1)?;
     let one = t0.elapsed().as_secs_f64().max(1e-7);
@@ -278,7 +285,7 @@ fn measure(budget: f64, mut f: impl FnMut(usize) -> Result<()>) -> Result<Rate> 
     })
 }
 
-fn cpu_model() -> String {
+pub(crate) fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {
@@ -290,7 +297,7 @@ fn cpu_model() -> String {
 }
 
 /// Parallel copy of 64 MiB (best of 5): bytes read plus bytes written per second.
-fn cpu_bandwidth() -> f64 {
+pub(crate) fn cpu_bandwidth() -> f64 {
     use rayon::prelude::*;
     let n = 16 << 20;
     let src = vec![1.0f32; n];
@@ -306,7 +313,7 @@ fn cpu_bandwidth() -> f64 {
 }
 
 /// Buffer-to-buffer copy of 64 MiB on the GPU (best of 5): bytes read plus written per second.
-fn gpu_bandwidth(ctx: &sylva_gpu::GpuContext) -> Result<f64> {
+pub(crate) fn gpu_bandwidth(ctx: &sylva_gpu::GpuContext) -> Result<f64> {
     let bytes = 64u64 << 20;
     let make = |label| {
         ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -396,34 +403,11 @@ fn markdown(rep: &Report) -> String {
 
 /// Steps per second against particles, log–log: the paper, the CPU and the GPU.
 fn plot(rep: &Report, path: &Path) -> Result<()> {
-    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, crate::wind_cmd::FONT);
-    let tmp = path.with_extension("tmp.png");
-    {
-        let root = BitMapBackend::new(&tmp, (900, 600)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let xs: Vec<f64> = rep.rows.iter().map(|r| r.particles.max(1) as f64).collect();
-        let mut ys: Vec<f64> = rep.rows.iter().map(|r| r.paper_fps).collect();
-        ys.extend(rep.rows.iter().filter_map(|r| r.cpu.map(|c| c.median)));
-        ys.extend(rep.rows.iter().filter_map(|r| r.gpu.map(|g| g.median)));
-        let x_lo = xs.iter().copied().fold(f64::INFINITY, f64::min).min(rep.rows[0].paper_particles as f64) * 0.7;
-        let x_hi = xs.iter().copied().fold(0.0, f64::max).max(1.0) * 1.4;
-        let y_lo = ys.iter().copied().fold(f64::INFINITY, f64::min).max(1e-3) * 0.5;
-        let y_hi = ys.iter().copied().fold(0.0, f64::max).max(1.0) * 2.0;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(format!("{} — steps per second", rep.title), ("sans-serif", 22))
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())?;
-        chart
-            .configure_mesh()
-            .x_desc("particles")
-            .y_desc("steps per second")
-            .x_label_formatter(&|x| format!("{x:.0}"))
-            .y_label_formatter(&|y| format!("{y:.0}"))
-            .draw()?;
-        type Series = (&'static str, RGBColor, Vec<(f64, f64)>);
-        let series: [Series; 3] = [
+    plot_series(
+        &format!("{} — steps per second", rep.title),
+        "particles",
+        "steps per second",
+        vec![
             (
                 "paper (GTX 580)",
                 RGBColor(120, 120, 120),
@@ -439,7 +423,41 @@ fn plot(rep: &Report, path: &Path) -> Result<()> {
                 RGBColor(40, 90, 200),
                 rep.rows.iter().filter_map(|r| r.gpu.map(|g| (r.particles as f64, g.median))).collect(),
             ),
-        ];
+        ],
+        path,
+    )
+}
+
+/// A named, coloured series of (x, y) points.
+pub(crate) type Series = (&'static str, RGBColor, Vec<(f64, f64)>);
+
+/// A log–log line plot of `series`, written atomically to `path` (PNG).
+pub(crate) fn plot_series(title: &str, x_desc: &str, y_desc: &str, series: Vec<Series>, path: &Path) -> Result<()> {
+    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, crate::wind_cmd::FONT);
+    let tmp = path.with_extension("tmp.png");
+    {
+        let root = BitMapBackend::new(&tmp, (900, 600)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let pts = series.iter().flat_map(|s| s.2.iter().copied());
+        let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
+        for (x, y) in pts {
+            (x_lo, x_hi, y_lo, y_hi) = (x_lo.min(x), x_hi.max(x), y_lo.min(y), y_hi.max(y));
+        }
+        let (x_lo, x_hi) = (x_lo.min(x_hi).max(1e-9) * 0.7, x_hi.max(1.0) * 1.4);
+        let (y_lo, y_hi) = (y_lo.min(y_hi).max(1e-6) * 0.5, y_hi.max(1e-3) * 2.0);
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())?;
+        chart
+            .configure_mesh()
+            .x_desc(x_desc)
+            .y_desc(y_desc)
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .y_label_formatter(&|y| if *y >= 10.0 { format!("{y:.0}") } else { format!("{y:.2}") })
+            .draw()?;
         for (label, color, pts) in series {
             if pts.is_empty() {
                 continue;
@@ -457,7 +475,7 @@ fn plot(rep: &Report, path: &Path) -> Result<()> {
     Ok(())
 }
 
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = path.with_extension(format!("{}.tmp", path.extension().and_then(|e| e.to_str()).unwrap_or("out")));
     std::fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display()))?;
     std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))

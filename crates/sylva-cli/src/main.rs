@@ -2,6 +2,7 @@
 //!
 //! With no arguments, runs the main job: `sylva render` on the built-in default scene.
 
+mod bench_akagi;
 mod bench_cmd;
 mod render_cmd;
 mod simulate_cmd;

@@ -359,6 +359,23 @@ fn bench_quick_writes_complete_tables() {
         let png = std::fs::read(dir.path().join(format!("b/{table}.png"))).unwrap();
         assert_eq!(&png[..4], b"\x89PNG");
     }
+    // Akagi's Table 2: one-thread, all-thread and GPU mesh timings per row.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("b/akagi-t2.json")).unwrap()).unwrap();
+    assert_eq!(json["table"], "akagi-t2");
+    let rows = json["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3);
+    for r in rows {
+        assert!(r["triangles"].as_u64().unwrap() >= r["paper_triangles"].as_u64().unwrap());
+        for key in ["cpu_one_ms", "cpu_all_ms"] {
+            let [m, lo, hi] = [0, 1, 2].map(|i| r[key][i].as_f64().unwrap());
+            assert!(lo <= m && m <= hi && m > 0.0, "{key}: {m} ({lo}–{hi})");
+        }
+        assert_eq!(r["gpu_ms"].is_null(), !gpu);
+    }
+    let md = std::fs::read_to_string(dir.path().join("b/akagi-t2.md")).unwrap();
+    assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 2 + 3, "{md}");
+    assert_eq!(&std::fs::read(dir.path().join("b/akagi-t2.png")).unwrap()[..4], b"\x89PNG");
     let leftovers: Vec<_> = std::fs::read_dir(dir.path().join("b"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())

@@ -176,3 +176,28 @@ fn bad_parameters_are_refused_with_the_field_named() {
         }
     }
 }
+
+#[test]
+fn a_forest_layout_meshes_like_its_trees() {
+    let (a, b) = (tree("palm"), tree("ternary"));
+    let p = MeshParams::default();
+    let (la, lb) = (MeshLayout::new(&a, p).unwrap(), MeshLayout::new(&b, p).unwrap());
+    let forest = MeshLayout::concat(&[&la, &lb]).unwrap();
+    let (pa, pb) = (random_pose(&a, 1, 0.1), random_pose(&b, 2, 0.1));
+    let (mut joint, mut acc) = sylva_core::mesh::pose_buffers(&a, &pa);
+    let (jb, ab) = sylva_core::mesh::pose_buffers(&b, &pb);
+    joint.extend(jb);
+    acc.extend(ab);
+    let m = forest.mesh_raw(&joint, &acc);
+    let (ma, mb) = (la.mesh(&a, &pa), lb.mesh(&b, &pb));
+    assert_eq!(m.tubes, [ma.tubes.clone(), mb.tubes.clone()].concat());
+    assert_eq!(m.leaves, [ma.leaves.clone(), mb.leaves.clone()].concat());
+    assert_eq!(forest.triangle_count(), la.triangle_count() + lb.triangle_count());
+    let off = la.tube_vertex_count() as u32;
+    assert_eq!(
+        &forest.tube_indices[la.tube_indices.len()..],
+        &lb.tube_indices.iter().map(|i| i + off).collect::<Vec<_>>()[..]
+    );
+    let other = MeshLayout::new(&b, MeshParams { sides: 5, ..p }).unwrap();
+    assert!(MeshLayout::concat(&[&la, &other]).is_err());
+}

@@ -38,6 +38,8 @@ pub struct GpuMesh {
     pub leaf_index_count: u32,
     tube_vertex_count: usize,
     leaf_vertex_count: usize,
+    ring_count: usize,
+    leaf_count: usize,
     segment_count: usize,
 }
 
@@ -88,6 +90,8 @@ impl GpuMesh {
             leaf_index_count: layout.leaf_indices.len() as u32,
             tube_vertex_count: layout.tube_vertex_count(),
             leaf_vertex_count: layout.leaf_vertex_count(),
+            ring_count: layout.rings.len(),
+            leaf_count: layout.leaves.len(),
             segment_count: n,
         })
     }
@@ -101,20 +105,20 @@ impl GpuMesh {
         joint: &wgpu::Buffer,
         acc: &wgpu::Buffer,
     ) {
-        if self.tube_vertex_count > 0 {
+        if self.ring_count > 0 {
             self.tubes.record(
                 ctx,
                 encoder,
                 &[&self.info, &self.rings, &self.segments, joint, acc, &self.tube_vertices],
-                self.tube_vertex_count as u32,
+                self.ring_count as u32,
             );
         }
-        if self.leaf_vertex_count > 0 {
+        if self.leaf_count > 0 {
             self.leaves_kernel.record(
                 ctx,
                 encoder,
                 &[&self.info, &self.leaves, &self.segments, joint, acc, &self.leaf_vertices],
-                self.leaf_vertex_count as u32,
+                self.leaf_count as u32,
             );
         }
     }

@@ -6,7 +6,8 @@ use crate::model::{RawLeaf, RawSegment};
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
-/// Writes `vertex[l × (leaf_sides + 1) + k]`: k = 0 the polygon's centre, 1… its rim.
+/// Writes leaf l's polygon `vertex[l × (leaf_sides + 1) ..][..leaf_sides + 1]`: k = 0 the
+/// centre, 1… the rim; the leaf's transform once, then the unit polygon scaled to the blade.
 /// Bindings as in the kernel: 0 info, 1 leaf, 2 segment, 3 joint, 4 acc, 5 vertex (write).
 pub fn mesh_leaves(
     info: &RawMeshInfo,
@@ -17,28 +18,30 @@ pub fn mesh_leaves(
     vertex: &mut [RawVertex],
 ) {
     let stride = info.leaf_sides as usize + 1;
-    vertex.par_iter_mut().enumerate().for_each(|(vid, out)| {
-        let lf = &leaf[vid / stride];
-        let k = (vid % stride) as u32;
+    let unit: Vec<(f32, f32)> = (0..info.leaf_sides)
+        .map(|k| {
+            let a = std::f32::consts::TAU * k as f32 / info.leaf_sides as f32;
+            (a.sin(), a.cos())
+        })
+        .collect();
+    vertex.par_chunks_mut(stride).zip(leaf.par_iter()).for_each(|(out, lf)| {
         let s = lf.segment as usize;
         let d = Quat::from_array(acc[s]);
         let base = Vec3::new(joint[s][0], joint[s][1], joint[s][2])
             + d * (Vec3::from_array(lf.position) - Vec3::from_array(segment[s].start));
         let q = d * Quat::from_array(lf.orientation);
-        let mut local = Vec3::new(0.0, 0.5 * lf.length, 0.0);
-        if k > 0 {
-            // Two half-circles of the unit n-gon, scaled to the blade: base at a = 0, tip
-            // at a = π.
-            let a = std::f32::consts::TAU * (k - 1) as f32 / info.leaf_sides as f32;
-            local = Vec3::new(a.sin() * 0.5 * lf.width, (1.0 - a.cos()) * 0.5 * lf.length, 0.0);
+        let (qx, qy) = (q * Vec3::X, q * Vec3::Y);
+        let normal = (q * Vec3::Z).to_array();
+        for (k, v) in out.iter_mut().enumerate() {
+            // (u, v) on the blade: the centre, then two half-circles of the unit n-gon from
+            // the base (a = 0) to the tip (a = π), scaled to width and length.
+            let mut uv = (0.5, 0.5);
+            if k > 0 {
+                let (sin, cos) = unit[k - 1];
+                uv = (0.5 * sin + 0.5, 0.5 - 0.5 * cos);
+            }
+            let p = base + qx * ((uv.0 - 0.5) * lf.width) + qy * (uv.1 * lf.length);
+            *v = RawVertex { position: p.to_array(), u: uv.0, normal, v: uv.1 };
         }
-        let p = base + q * local;
-        let normal = q * Vec3::Z;
-        *out = RawVertex {
-            position: p.to_array(),
-            u: local.x / lf.width.max(1e-9) + 0.5,
-            normal: normal.to_array(),
-            v: local.y / lf.length.max(1e-9),
-        };
     });
 }

@@ -12,7 +12,8 @@ fn world_orientation(segment: &[RawSegment], acc: &[[f32; 4]], i: usize) -> Quat
     Quat::from_array(acc[i]) * Quat::from_array(segment[i].orientation)
 }
 
-/// Writes `vertex[r × (sides + 1) + k]`, the k-th vertex of ring r.
+/// Writes ring r's vertices `vertex[r × (sides + 1) ..][..sides + 1]`: the centreline
+/// point and frame once per ring, then the unit polygon placed around it.
 /// Bindings as in the kernel: 0 info, 1 ring, 2 segment, 3 joint, 4 acc, 5 vertex (write).
 pub fn mesh_tubes(
     info: &RawMeshInfo,
@@ -23,9 +24,14 @@ pub fn mesh_tubes(
     vertex: &mut [RawVertex],
 ) {
     let stride = info.sides as usize + 1;
-    vertex.par_iter_mut().enumerate().for_each(|(vid, out)| {
-        let rg = ring[vid / stride];
-        let k = (vid % stride) as u32;
+    // The unit polygon (Akagi: a precomputed octagon), one angle per side.
+    let unit: Vec<(f32, f32)> = (0..info.sides)
+        .map(|k| {
+            let angle = std::f32::consts::TAU * (k as f32 / info.sides as f32);
+            (angle.cos(), angle.sin())
+        })
+        .collect();
+    vertex.par_chunks_mut(stride).zip(ring.par_iter()).for_each(|(out, rg)| {
         let i = rg.segment as usize;
         let seg = &segment[i];
         let q = world_orientation(segment, acc, i);
@@ -50,15 +56,27 @@ pub fn mesh_tubes(
             p0 * (2.0 * t3 - 3.0 * t2 + 1.0) + m0 * (t3 - 2.0 * t2 + t) + p1 * (-2.0 * t3 + 3.0 * t2) + m1 * (t3 - t2);
         let frame = quat_slerp(f0, f1, t);
         let radius = rg.radius;
-        let kk = k % info.sides;
-        let around = kk as f32 / info.sides as f32;
-        let angle = std::f32::consts::TAU * around;
-        let radial = frame * Vec3::new(angle.cos(), 0.0, angle.sin());
+        let (fx, fy, fz) = (frame * Vec3::X, frame * Vec3::Y, frame * Vec3::Z);
+        // The normal leans along the axis by the taper; |radial + fy·slope| is the same for
+        // every vertex of the ring.
         let slope = (seg.radius_base - seg.radius_tip) / seg.length.max(1e-6);
-        let normal = (radial + frame * Vec3::Y * slope).normalize();
-        let relief = rg.relief * radius * bark_relief(around, rg.v, rg.stem_seed);
-        let p = centre + radial * radius + normal * relief;
-        *out =
-            RawVertex { position: p.to_array(), u: k as f32 / info.sides as f32, normal: normal.to_array(), v: rg.v };
+        let lean = 1.0 / (1.0 + slope * slope).sqrt();
+        for (k, v) in out.iter_mut().enumerate() {
+            let kk = k % info.sides as usize;
+            let (c, s) = unit[kk];
+            let radial = fx * c + fz * s;
+            let normal = (radial + fy * slope) * lean;
+            let mut p = centre + radial * radius;
+            if rg.relief != 0.0 {
+                let around = kk as f32 / info.sides as f32;
+                p += normal * (rg.relief * radius * bark_relief(around, rg.v, rg.stem_seed));
+            }
+            *v = RawVertex {
+                position: p.to_array(),
+                u: k as f32 / info.sides as f32,
+                normal: normal.to_array(),
+                v: rg.v,
+            };
+        }
     });
 }

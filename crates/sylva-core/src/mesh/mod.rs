@@ -64,6 +64,18 @@ impl Default for MeshParams {
     }
 }
 
+/// Akagi & Kitajima Table 2 (Core2 Extreme QX9650, GeForce GTX 280): (polygons, CPU
+/// single-thread generation + drawing, GPU generation + drawing), seconds per 1,000 frames.
+pub const AKAGI_TABLE_2: [(usize, f64, f64); 7] = [
+    (108_808, 1.27, 0.006),
+    (201_760, 2.58, 0.013),
+    (450_592, 6.52, 0.032),
+    (823_840, 12.45, 0.064),
+    (1_321_504, 20.38, 0.108),
+    (2_536_192, 39.79, 0.196),
+    (4_109_056, 65.28, 0.352),
+];
+
 /// Largest sides / samples accepted (bounds memory on user input).
 pub const MAX_SIDES: u32 = 64;
 /// Smallest ring radius as a fraction of its stem's base radius.
@@ -259,6 +271,54 @@ impl MeshLayout {
             segments: tree.raw_segments(),
             leaves: if params.leaves { tree.raw_leaves() } else { Vec::new() },
         })
+    }
+
+    /// Several trees' layouts as one mesh (a forest in one dispatch): segment, ring and
+    /// vertex indices offset; the pose buffers are the trees' concatenated in the same
+    /// order. Every layout must have the same sides and leaf sides.
+    pub fn concat(layouts: &[&MeshLayout]) -> Result<Self, MeshError> {
+        let first = layouts.first().ok_or(MeshError::Param {
+            field: "layouts",
+            value: "none".into(),
+            expected: "at least one layout",
+        })?;
+        let params = first.params;
+        let mut out = MeshLayout {
+            params,
+            rings: Vec::new(),
+            tube_indices: Vec::new(),
+            leaf_indices: Vec::new(),
+            segments: Vec::new(),
+            leaves: Vec::new(),
+        };
+        for l in layouts {
+            if (l.params.sides, l.params.leaf_sides) != (params.sides, params.leaf_sides) {
+                return Err(MeshError::Param {
+                    field: "sides",
+                    value: l.params.sides.to_string(),
+                    expected: "the same sides and leaf sides in every layout of a forest",
+                });
+            }
+            let seg = out.segments.len() as u32;
+            let shift = |i: u32| if i == NONE { NONE } else { i + seg };
+            let (tv, lv) = (out.tube_vertex_count() as u32, out.leaf_vertex_count() as u32);
+            out.rings.extend(l.rings.iter().map(|r| RawRing {
+                segment: r.segment + seg,
+                prev: shift(r.prev),
+                next: shift(r.next),
+                ..*r
+            }));
+            out.tube_indices.extend(l.tube_indices.iter().map(|i| i + tv));
+            out.leaf_indices.extend(l.leaf_indices.iter().map(|i| i + lv));
+            out.segments.extend(l.segments.iter().map(|s| RawSegment { parent: shift(s.parent), ..*s }));
+            out.leaves.extend(l.leaves.iter().map(|f| RawLeaf { segment: f.segment + seg, ..*f }));
+        }
+        for v in [out.tube_vertex_count() as u64, out.leaf_vertex_count() as u64] {
+            if v > MAX_VERTICES {
+                return Err(MeshError::TooLarge { vertices: v, limit: MAX_VERTICES });
+            }
+        }
+        Ok(out)
     }
 
     /// Frame constants for the kernels.

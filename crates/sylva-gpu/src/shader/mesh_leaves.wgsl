@@ -1,5 +1,6 @@
-// mesh_leaves: one leaf-polygon vertex per invocation (Akagi §2.4): k = 0 the centre, 1..
-// the rim, two half-circles of the unit n-gon scaled to the blade.
+// mesh_leaves: one leaf per invocation (Akagi §2.4): the leaf's transform once, then its
+// polygon — k = 0 the centre, 1.. the rim, two half-circles of the unit n-gon scaled to the
+// blade.
 // CPU twin: sylva_core::cpu::mesh_leaves (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> info: MeshInfo;
@@ -11,23 +12,26 @@
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let vid = gid.x + gid.y * nwg.x * 64u;
-    let stride = info.leaf_sides + 1u;
-    if (vid >= info.leaves * stride) {
+    let l = gid.x + gid.y * nwg.x * 64u;
+    if (l >= info.leaves) {
         return;
     }
-    let lf = leaf[vid / stride];
-    let k = vid % stride;
+    let stride = info.leaf_sides + 1u;
+    let lf = leaf[l];
     let s = lf.segment;
     let d = acc[s];
     let base = joint[s].xyz + quat_rotate(d, lf.position - segment[s].start);
     let q = quat_mul(d, lf.orientation);
-    var local = vec3<f32>(0.0, 0.5 * lf.length, 0.0);
-    if (k > 0u) {
-        let a = TAU * f32(k - 1u) / f32(info.leaf_sides);
-        local = vec3<f32>(sin(a) * 0.5 * lf.width, (1.0 - cos(a)) * 0.5 * lf.length, 0.0);
-    }
-    let p = base + quat_rotate(q, local);
+    let qx = quat_rotate(q, vec3<f32>(1.0, 0.0, 0.0));
+    let qy = quat_rotate(q, vec3<f32>(0.0, 1.0, 0.0));
     let normal = quat_rotate(q, vec3<f32>(0.0, 0.0, 1.0));
-    vertex[vid] = Vertex(p, local.x / max(lf.width, 1e-9) + 0.5, normal, local.y / max(lf.length, 1e-9));
+    for (var k = 0u; k < stride; k++) {
+        var uv = vec2<f32>(0.5, 0.5);
+        if (k > 0u) {
+            let a = TAU * f32(k - 1u) / f32(info.leaf_sides);
+            uv = vec2<f32>(0.5 * sin(a) + 0.5, 0.5 - 0.5 * cos(a));
+        }
+        let p = base + qx * ((uv.x - 0.5) * lf.width) + qy * (uv.y * lf.length);
+        vertex[l * stride + k] = Vertex(p, uv.x, normal, uv.y);
+    }
 }

@@ -1,5 +1,6 @@
-// mesh_tubes: one bark vertex per invocation (Akagi §2.2–2.3): Hermite centreline, slerped
-// ring frame, interpolated radius, bark relief along the normal.
+// mesh_tubes: one ring per invocation (Akagi §2.2–2.3): the Hermite centreline point and
+// the slerped frame once, then the unit polygon placed around it with the interpolated
+// radius and the bark relief along the normal (sides + 1 vertices, the last the seam).
 // CPU twin: sylva_core::cpu::mesh_tubes (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> info: MeshInfo;
@@ -15,13 +16,12 @@ fn world_orientation(i: u32) -> vec4<f32> {
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let vid = gid.x + gid.y * nwg.x * 64u;
-    let stride = info.sides + 1u;
-    if (vid >= info.rings * stride) {
+    let r = gid.x + gid.y * nwg.x * 64u;
+    if (r >= info.rings) {
         return;
     }
-    let rg = ring[vid / stride];
-    let k = vid % stride;
+    let stride = info.sides + 1u;
+    let rg = ring[r];
     let i = rg.segment;
     let seg = segment[i];
     let q = world_orientation(i);
@@ -51,13 +51,21 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         + m1 * (t3 - t2);
     let frame = quat_slerp(f0, f1, t);
     let radius = rg.radius;
-    let kk = k % info.sides;
-    let around = f32(kk) / f32(info.sides);
-    let angle = TAU * around;
-    let radial = quat_rotate(frame, vec3<f32>(cos(angle), 0.0, sin(angle)));
+    let fx = quat_rotate(frame, vec3<f32>(1.0, 0.0, 0.0));
+    let fy = quat_rotate(frame, vec3<f32>(0.0, 1.0, 0.0));
+    let fz = quat_rotate(frame, vec3<f32>(0.0, 0.0, 1.0));
     let slope = (seg.radius_base - seg.radius_tip) / max(seg.length, 1e-6);
-    let normal = normalize(radial + quat_rotate(frame, vec3<f32>(0.0, 1.0, 0.0)) * slope);
-    let relief = rg.relief * radius * bark_relief(around, rg.v, rg.stem_seed);
-    let p = centre + radial * radius + normal * relief;
-    vertex[vid] = Vertex(p, f32(k) / f32(info.sides), normal, rg.v);
+    let lean = 1.0 / sqrt(1.0 + slope * slope);
+    for (var k = 0u; k < stride; k++) {
+        let kk = k % info.sides;
+        let around = f32(kk) / f32(info.sides);
+        let angle = TAU * around;
+        let radial = fx * cos(angle) + fz * sin(angle);
+        let normal = (radial + fy * slope) * lean;
+        var p = centre + radial * radius;
+        if (rg.relief != 0.0) {
+            p += normal * (rg.relief * radius * bark_relief(around, rg.v, rg.stem_seed));
+        }
+        vertex[r * stride + k] = Vertex(p, f32(k) / f32(info.sides), normal, rg.v);
+    }
 }

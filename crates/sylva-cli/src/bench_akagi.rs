@@ -1,0 +1,285 @@
+//! `sylva bench akagi-t2`: Akagi & Kitajima's Table 2 — regenerating the whole mesh of a
+//! forest every frame, 108,808 … 4,109,056 triangles, on one CPU thread, on every CPU core
+//! and on the GPU, with the paper's figures beside ours.
+//!
+//! Each row meshes a forest of whole trees (Quaking Aspens with different seeds, topped up
+//! with palms) whose triangle count first reaches the paper's; the actual count is
+//! reported. A frame is every bark and leaf vertex of the forest from a wind pose (Zioma at
+//! t = 2 s), as `sylva render` does it. GPU frames are the two mesh kernels, several frames
+//! per submission, wall clock to completion. The paper's figures include drawing (about
+//! 0.1 % of its CPU time); ours time generation only.
+
+use crate::bench_cmd::{Series, cpu_bandwidth, cpu_model, gpu_bandwidth, measure, plot_series, write_atomic};
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use plotters::style::RGBColor;
+use serde::Serialize;
+use std::path::PathBuf;
+use sylva_core::Tree;
+use sylva_core::animate::zioma::{Zioma, ZiomaParams};
+use sylva_core::mesh::{AKAGI_TABLE_2, MeshLayout, MeshParams, pose_buffers};
+use sylva_core::species::SpeciesSource;
+use sylva_core::wind::WindScene;
+
+/// One row.
+#[derive(Debug, Clone, Serialize)]
+pub struct AkagiRow {
+    /// The paper's polygons.
+    pub paper_triangles: usize,
+    /// The paper's CPU (one thread) ms per frame.
+    pub paper_cpu_ms: f64,
+    /// The paper's GPU ms per frame.
+    pub paper_gpu_ms: f64,
+    /// Our triangles.
+    pub triangles: usize,
+    /// Our vertices.
+    pub vertices: usize,
+    /// Trees in the forest.
+    pub trees: usize,
+    /// Bytes written and read per frame (vertices out, rings, leaves and pose in).
+    pub bytes_per_frame: usize,
+    /// CPU one thread, ms per frame (median, min, max).
+    pub cpu_one_ms: Option<[f64; 3]>,
+    /// CPU all threads, ms per frame.
+    pub cpu_all_ms: Option<[f64; 3]>,
+    /// GPU, ms per frame.
+    pub gpu_ms: Option<[f64; 3]>,
+    /// CPU (all threads) bytes/s over the measured copy bandwidth.
+    pub cpu_bandwidth_fraction: Option<f64>,
+    /// GPU bytes/s over the measured copy bandwidth.
+    pub gpu_bandwidth_fraction: Option<f64>,
+}
+
+fn ms(r: crate::bench_cmd::Rate) -> [f64; 3] {
+    [1e3 / r.median, 1e3 / r.max, 1e3 / r.min]
+}
+
+fn cell(v: Option<[f64; 3]>) -> String {
+    v.map_or("–".into(), |[m, lo, hi]| format!("{m:.2} ({lo:.2}–{hi:.2})"))
+}
+
+/// Runs the table; returns the files written.
+pub fn run(
+    quick: bool,
+    budget: f64,
+    time_cpu: bool,
+    ctx: Option<&'static sylva_gpu::GpuContext>,
+    out_dir: &std::path::Path,
+) -> Result<Vec<PathBuf>> {
+    let rows = if quick { &AKAGI_TABLE_2[..3] } else { &AKAGI_TABLE_2[..] };
+    let wind = WindScene::resolve("gusty")?;
+    let (fields, waves) = wind.pack();
+    let params = MeshParams::default();
+    // A pool of trees, generated on demand: aspens by seed, palms to top up.
+    let aspen = SpeciesSource::resolve("quaking_aspen")?;
+    let palm = SpeciesSource::resolve("palm")?;
+    let mut pool: Vec<(Tree, MeshLayout)> = Vec::new();
+    let mut palms: Vec<(Tree, MeshLayout)> = Vec::new();
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let cpu_bw = cpu_bandwidth();
+    let gpu_bw = match ctx {
+        Some(c) => Some(gpu_bandwidth(c)?),
+        None => None,
+    };
+    let bar = ProgressBar::new(rows.len() as u64).with_style(
+        ProgressStyle::with_template("{msg:>10} [{bar:30}] {pos}/{len} rows, {elapsed}").expect("valid template"),
+    );
+    bar.set_message("akagi-t2");
+    let mut out = Vec::new();
+    for &(paper_triangles, paper_cpu_s, paper_gpu_s) in rows {
+        // The forest: whole aspens while they fit, then palms until the count is reached.
+        let mut chosen: Vec<(bool, usize)> = Vec::new();
+        let mut total = 0usize;
+        let aspen_tris = {
+            if pool.is_empty() {
+                let t = aspen.generate(1, &Default::default(), None)?;
+                let l = MeshLayout::new(&t, params)?;
+                pool.push((t, l));
+            }
+            pool[0].1.triangle_count()
+        };
+        while total + aspen_tris <= paper_triangles {
+            let k = chosen.iter().filter(|c| c.0).count();
+            if k == pool.len() {
+                let t = aspen.generate(k as u64 + 1, &Default::default(), None)?;
+                let l = MeshLayout::new(&t, params)?;
+                pool.push((t, l));
+            }
+            total += pool[k].1.triangle_count();
+            chosen.push((true, k));
+        }
+        while total < paper_triangles {
+            let k = chosen.iter().filter(|c| !c.0).count();
+            if k == palms.len() {
+                let t = palm.generate(k as u64 + 1, &Default::default(), None)?;
+                let l = MeshLayout::new(&t, params)?;
+                palms.push((t, l));
+            }
+            total += palms[k].1.triangle_count();
+            chosen.push((false, k));
+        }
+        let members: Vec<&(Tree, MeshLayout)> =
+            chosen.iter().map(|&(a, k)| if a { &pool[k] } else { &palms[k] }).collect();
+        let layout = MeshLayout::concat(&members.iter().map(|m| &m.1).collect::<Vec<_>>())?;
+        let (mut joint, mut acc) = (Vec::new(), Vec::new());
+        for (t, _) in &members {
+            let pose = Zioma::new(t, ZiomaParams::default()).pose_packed(t, &fields, &waves, 2.0);
+            let (j, a) = pose_buffers(t, &pose);
+            joint.extend(j);
+            acc.extend(a);
+        }
+        let vertices = layout.tube_vertex_count() + layout.leaf_vertex_count();
+        let bytes =
+            vertices * 32 + layout.rings.len() * 32 + layout.leaves.len() * 48 + layout.segments.len() * (96 + 32);
+        let info = layout.info();
+        let mut tubes = vec![bytemuck::Zeroable::zeroed(); layout.tube_vertex_count()];
+        let mut leaves = vec![bytemuck::Zeroable::zeroed(); layout.leaf_vertex_count()];
+        let mut frame = || {
+            sylva_core::cpu::mesh_tubes(&info, &layout.rings, &layout.segments, &joint, &acc, &mut tubes);
+            sylva_core::cpu::mesh_leaves(&info, &layout.leaves, &layout.segments, &joint, &acc, &mut leaves);
+        };
+        let (cpu_one, cpu_all) = if time_cpu {
+            let one = one_thread.install(|| {
+                measure(budget, |n| {
+                    (0..n).for_each(|_| frame());
+                    Ok(())
+                })
+            })?;
+            let all = measure(budget, |n| {
+                (0..n).for_each(|_| frame());
+                Ok(())
+            })?;
+            (Some(one), Some(all))
+        } else {
+            (None, None)
+        };
+        let gpu = match ctx {
+            Some(c) => {
+                let mesh = sylva_gpu::mesh::GpuMesh::new(c, &layout)?;
+                let jb = sylva_gpu::kernel::upload(c, "bench joints", &joint)?;
+                let ab = sylva_gpu::kernel::upload(c, "bench rotations", &acc)?;
+                Some(measure(budget, |n| {
+                    let mut e = c.device.create_command_encoder(&Default::default());
+                    for _ in 0..n {
+                        mesh.record(c, &mut e, &jb, &ab);
+                    }
+                    c.queue.submit([e.finish()]);
+                    c.wait()?;
+                    Ok(())
+                })?)
+            }
+            None => None,
+        };
+        let row = AkagiRow {
+            paper_triangles,
+            paper_cpu_ms: paper_cpu_s,
+            paper_gpu_ms: paper_gpu_s,
+            triangles: layout.triangle_count(),
+            vertices,
+            trees: members.len(),
+            bytes_per_frame: bytes,
+            cpu_one_ms: cpu_one.map(ms),
+            cpu_all_ms: cpu_all.map(ms),
+            gpu_ms: gpu.map(ms),
+            cpu_bandwidth_fraction: cpu_all.map(|r| r.median * bytes as f64 / cpu_bw),
+            gpu_bandwidth_fraction: gpu.zip(gpu_bw).map(|(r, b)| r.median * bytes as f64 / b),
+        };
+        bar.suspend(|| {
+            println!(
+                "{:>9} triangles ({} trees): CPU 1 thread {} ms, all threads {} ms, GPU {} ms (paper CPU {:.2}, GPU {:.3})",
+                row.triangles,
+                row.trees,
+                cell(row.cpu_one_ms),
+                cell(row.cpu_all_ms),
+                cell(row.gpu_ms),
+                row.paper_cpu_ms,
+                row.paper_gpu_ms
+            )
+        });
+        out.push(row);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    let machine = format!(
+        "{} ({} threads), CPU copy bandwidth {:.1} GB/s{}",
+        cpu_model(),
+        rayon::current_num_threads(),
+        cpu_bw / 1e9,
+        match (ctx, gpu_bw) {
+            (Some(c), Some(b)) => format!("; GPU {}, copy bandwidth {:.1} GB/s", c.summary, b / 1e9),
+            _ => String::new(),
+        }
+    );
+    let date = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
+    let command = std::env::args().collect::<Vec<_>>().join(" ");
+    let mut md = "### Akagi & Kitajima Table 2: mesh regeneration per frame (akagi-t2)\n\n".to_string();
+    md += &format!("Machine: {machine}.\nDate {date}. Command `{command}`.\n\n");
+    md += "ms per frame, median (min–max). The paper: Core2 QX9650 one thread, GeForce GTX 280, generation + drawing.\n\n";
+    md += "| paper triangles | paper CPU ms | paper GPU ms | paper CPU/GPU | triangles | trees | MB/frame | CPU 1 thread ms | CPU all threads ms | CPU % of bandwidth | GPU ms | GPU % of bandwidth | CPU 1 thread / GPU | CPU all / GPU |\n";
+    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    let ratio = |a: Option<[f64; 3]>, b: Option<[f64; 3]>| match (a, b) {
+        (Some(a), Some(b)) => format!("{:.1}", a[0] / b[0]),
+        _ => "–".into(),
+    };
+    for r in &out {
+        md += &format!(
+            "| {} | {:.2} | {:.3} | {:.0} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} |\n",
+            r.paper_triangles,
+            r.paper_cpu_ms,
+            r.paper_gpu_ms,
+            r.paper_cpu_ms / r.paper_gpu_ms,
+            r.triangles,
+            r.trees,
+            r.bytes_per_frame as f64 / 1e6,
+            cell(r.cpu_one_ms),
+            cell(r.cpu_all_ms),
+            r.cpu_bandwidth_fraction.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f)),
+            cell(r.gpu_ms),
+            r.gpu_bandwidth_fraction.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f)),
+            ratio(r.cpu_one_ms, r.gpu_ms),
+            ratio(r.cpu_all_ms, r.gpu_ms),
+        );
+    }
+    #[derive(Serialize)]
+    struct Report<'a> {
+        table: &'static str,
+        machine: &'a str,
+        date: &'a str,
+        command: &'a str,
+        rows: &'a [AkagiRow],
+    }
+    let json = serde_json::to_string_pretty(&Report {
+        table: "akagi-t2",
+        machine: &machine,
+        date: &date,
+        command: &command,
+        rows: &out,
+    })?;
+    let (md_path, json_path, png_path) =
+        (out_dir.join("akagi-t2.md"), out_dir.join("akagi-t2.json"), out_dir.join("akagi-t2.png"));
+    write_atomic(&md_path, md.as_bytes())?;
+    write_atomic(&json_path, json.as_bytes())?;
+    let pick = |f: fn(&AkagiRow) -> Option<f64>| -> Vec<(f64, f64)> {
+        out.iter().filter_map(|r| f(r).map(|y| (r.triangles as f64, y))).collect()
+    };
+    let series: Vec<Series> = vec![
+        (
+            "paper CPU (1 thread)",
+            RGBColor(170, 170, 170),
+            out.iter().map(|r| (r.paper_triangles as f64, r.paper_cpu_ms)).collect(),
+        ),
+        (
+            "paper GPU (GTX 280)",
+            RGBColor(90, 90, 90),
+            out.iter().map(|r| (r.paper_triangles as f64, r.paper_gpu_ms)).collect(),
+        ),
+        ("CPU 1 thread", RGBColor(230, 140, 60), pick(|r| r.cpu_one_ms.map(|v| v[0]))),
+        ("CPU all threads", RGBColor(200, 60, 40), pick(|r| r.cpu_all_ms.map(|v| v[0]))),
+        ("GPU", RGBColor(40, 90, 200), pick(|r| r.gpu_ms.map(|v| v[0]))),
+    ];
+    plot_series("Akagi & Kitajima Table 2 — mesh regeneration", "triangles", "ms per frame", series, &png_path)
+        .context("plotting akagi-t2")?;
+    println!("{md}");
+    Ok(vec![md_path, json_path, png_path])
+}
