@@ -15,8 +15,8 @@ use sylva_core::animate::Pose;
 use sylva_core::animate::akagi::{Akagi, AkagiParams, AkagiState};
 use sylva_core::animate::hsm::{Hsm, HsmParams, HsmState};
 use sylva_core::animate::skjermo::{Skjermo, SkjermoParams, SkjermoState};
-use sylva_core::animate::zioma::{Zioma, ZiomaParams};
-use sylva_core::mesh::{MeshLayout, MeshParams};
+use sylva_core::animate::zioma::{Zioma, ZiomaInstance, ZiomaParams};
+use sylva_core::mesh::{MeshLayout, MeshParams, SkinLayout, pose_buffers};
 use sylva_core::scene::{BackendChoice, MethodName, Scene};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
@@ -25,6 +25,7 @@ use sylva_core::{Limits, Tree};
 use sylva_gpu::GpuContext;
 use sylva_gpu::mesh::GpuMesh;
 use sylva_gpu::render::{Camera, DrawItem, Instance, Lighting, RenderSettings, Renderer};
+use sylva_gpu::skin::GpuSkin;
 
 /// Arguments of `sylva render`.
 #[derive(clap::Args, Debug, Default)]
@@ -193,6 +194,95 @@ impl Anim {
     }
 }
 
+/// Zioma trees with copies (§6.5): every instance its own wind sample, phase and trunk
+/// seed, all skinned from one rest mesh on the GPU.
+struct ZiomaForest {
+    method: Zioma,
+    instances: Vec<ZiomaInstance>,
+    gpu: Option<sylva_gpu::pose::GpuZioma>,
+    skin: GpuSkin,
+    joint: wgpu::Buffer,
+    acc: wgpu::Buffer,
+}
+
+impl ZiomaForest {
+    fn new(
+        ctx: &GpuContext,
+        tree: &Tree,
+        layout: &MeshLayout,
+        placements: &[Instance],
+        gpu: bool,
+        seed: u64,
+        wind: &WindScene,
+    ) -> Result<Self> {
+        let method = Zioma::new(tree, ZiomaParams { seed, ..Default::default() });
+        let instances: Vec<ZiomaInstance> = placements
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                let (_, rotation, position) = p.transform.to_scale_rotation_translation();
+                let key = sylva_core::rng::mix64(seed ^ (k as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+                ZiomaInstance {
+                    position,
+                    yaw: rotation.to_euler(glam::EulerRot::YXZ).0,
+                    phase: (key & 0xFFFF) as f32 / 65_536.0,
+                    seed: (key >> 32) as u32,
+                }
+            })
+            .collect();
+        let n = instances.len() * tree.segments.len();
+        let g = if gpu {
+            Some(sylva_gpu::pose::GpuZioma::with_instances(ctx, tree, &method, wind, &instances)?)
+        } else {
+            None
+        };
+        Ok(Self {
+            skin: GpuSkin::new(ctx, layout, &SkinLayout::new(layout), instances.len() as u32)?,
+            joint: sylva_gpu::kernel::output::<[f32; 4]>(ctx, "forest joints", n)?,
+            acc: sylva_gpu::kernel::output::<[f32; 4]>(ctx, "forest rotations", n)?,
+            method,
+            instances,
+            gpu: g,
+        })
+    }
+
+    fn frame(
+        &self,
+        ctx: &GpuContext,
+        tree: &Tree,
+        wind: (&[RawField], &[RawWave]),
+        t: f32,
+        encoder: &mut wgpu::CommandEncoder,
+    ) {
+        match &self.gpu {
+            Some(g) => {
+                g.submit(ctx, tree, &self.method, t);
+                self.skin.record(ctx, encoder, g.gpu_pose().joints_buffer(), g.gpu_pose().acc_buffer());
+            }
+            None => {
+                let delta = self.method.rotations_instances(tree, wind.0, wind.1, t, &self.instances);
+                let (mut joint, mut acc) = (Vec::new(), Vec::new());
+                for pose in Pose::from_rotations_instances(tree, &delta) {
+                    let (j, a) = pose_buffers(tree, &pose);
+                    joint.extend(j);
+                    acc.extend(a);
+                }
+                ctx.queue.write_buffer(&self.joint, 0, bytemuck::cast_slice(&joint));
+                ctx.queue.write_buffer(&self.acc, 0, bytemuck::cast_slice(&acc));
+                self.skin.record(ctx, encoder, &self.joint, &self.acc);
+            }
+        }
+    }
+}
+
+/// A tree of the scene as it is animated and drawn.
+enum Drawn {
+    /// One animated mesh, drawn once per instance.
+    Single(Anim, GpuMesh),
+    /// Skinned instances, each with its own pose.
+    Forest(ZiomaForest),
+}
+
 /// A temporary file renamed into place on success and removed otherwise.
 struct Pending {
     tmp: PathBuf,
@@ -328,12 +418,30 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
 
     struct Entry {
         tree: Tree,
-        anim: Anim,
-        mesh: GpuMesh,
+        drawn: Drawn,
         instances: wgpu::Buffer,
         count: u32,
         label: String,
         base: Vec3,
+    }
+    impl Entry {
+        fn advance(
+            &mut self,
+            ctx: &GpuContext,
+            wind: (&[RawField], &[RawWave]),
+            t: f32,
+            dt: f32,
+            steps: usize,
+            encoder: &mut wgpu::CommandEncoder,
+        ) -> Result<()> {
+            match &mut self.drawn {
+                Drawn::Single(anim, mesh) => anim.advance_and_mesh(ctx, &self.tree, wind, t, dt, steps, mesh, encoder),
+                Drawn::Forest(f) => {
+                    f.frame(ctx, &self.tree, wind, t, encoder);
+                    Ok(())
+                }
+            }
+        }
     }
     let setup = Instant::now();
     let mut entries = Vec::new();
@@ -349,7 +457,6 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
             BackendChoice::Cpu => false,
             BackendChoice::Gpu => true,
         };
-        let anim = Anim::new(ctx, &tree, st.method, gpu, st.seed, &wind)?;
         let defaults = MeshParams::default();
         let params = MeshParams {
             sides: st.sides.unwrap_or(defaults.sides),
@@ -358,7 +465,6 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         };
         let layout = MeshLayout::new(&tree, params)?;
         triangles += layout.triangle_count() * (1 + st.copies.len());
-        let mesh = GpuMesh::new(ctx, &layout)?;
         let tint = Vec3::from_array(st.tint.unwrap_or([0.28, 0.50, 0.12]));
         let mut inst = vec![instance(st.position, st.yaw_deg, st.scale, tint)];
         inst.extend(st.copies.iter().map(|c| instance(c.position, c.yaw_deg, c.scale, tint * 1.05)));
@@ -387,11 +493,17 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
             inst.len(),
             label
         );
+        let drawn = if st.method == MethodName::Zioma && inst.len() > 1 {
+            Drawn::Forest(ZiomaForest::new(ctx, &tree, &layout, &inst, gpu, st.seed, &wind)?)
+        } else {
+            Drawn::Single(Anim::new(ctx, &tree, st.method, gpu, st.seed, &wind)?, GpuMesh::new(ctx, &layout)?)
+        };
+        // Poses are in the tree's own frame (skinned instances sample the wind at their
+        // placement and turn it by their yaw); the instance transform places them.
         let instances = Renderer::instances(ctx, &inst);
         entries.push(Entry {
             tree,
-            anim,
-            mesh,
+            drawn,
             instances,
             count: inst.len() as u32,
             label,
@@ -477,7 +589,7 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         t = preroll_steps as f32 * dt;
         for e in &mut entries {
-            e.anim.advance_and_mesh(ctx, &e.tree, (&fields, &waves), t, dt, preroll_steps, &e.mesh, &mut encoder)?;
+            e.advance(ctx, (&fields, &waves), t, dt, preroll_steps, &mut encoder)?;
         }
         ctx.queue.submit([encoder.finish()]);
     }
@@ -499,12 +611,15 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         let advance = if f == 0 && preroll_steps > 0 { 0 } else { steps };
         t += advance as f32 * dt;
         for e in &mut entries {
-            e.anim.advance_and_mesh(ctx, &e.tree, (&fields, &waves), t, dt, advance, &e.mesh, &mut encoder)?;
+            e.advance(ctx, (&fields, &waves), t, dt, advance, &mut encoder)?;
         }
         let t1 = Instant::now();
         let items: Vec<DrawItem<'_>> = entries
             .iter()
-            .map(|e| DrawItem { mesh: &e.mesh, instances: &e.instances, instance_count: e.count })
+            .map(|e| match &e.drawn {
+                Drawn::Single(_, mesh) => mesh.draw_item(&e.instances, e.count),
+                Drawn::Forest(f) => f.skin.draw_item(&e.instances),
+            })
             .collect();
         renderer.record(ctx, &mut encoder, &globals, &items);
         let mut rgba = renderer.read_image(ctx, encoder)?;

@@ -201,3 +201,47 @@ fn a_forest_layout_meshes_like_its_trees() {
     let other = MeshLayout::new(&b, MeshParams { sides: 5, ..p }).unwrap();
     assert!(MeshLayout::concat(&[&la, &other]).is_err());
 }
+
+#[test]
+fn skinning_follows_the_pose_and_keeps_joint_rings_on_their_joints() {
+    use sylva_core::mesh::SkinLayout;
+    let t = tree("sassafras");
+    let l = MeshLayout::new(&t, MeshParams { bark_depth: 0.0, ..Default::default() }).unwrap();
+    let skin = SkinLayout::new(&l);
+    let h = t.height();
+    // At rest the skinned mesh is the rest mesh.
+    let rest = l.mesh(&t, &Pose::rest(&t));
+    let (j, a) = sylva_core::mesh::pose_buffers(&t, &Pose::rest(&t));
+    let same = skin.skin(&j, &a, 1);
+    for (x, y) in rest.tubes.iter().zip(&same.tubes).chain(rest.leaves.iter().zip(&same.leaves)) {
+        assert!((pos(x) - pos(y)).length() <= 1e-6 * h);
+    }
+    // Two instances with different poses: each follows its own; leaves exactly as meshed,
+    // joint rings centred on the posed joints, normals unit.
+    let poses = [random_pose(&t, 5, 0.15), random_pose(&t, 6, 0.15)];
+    let (mut joint, mut acc) = (Vec::new(), Vec::new());
+    for p in &poses {
+        let (j, a) = sylva_core::mesh::pose_buffers(&t, p);
+        joint.extend(j);
+        acc.extend(a);
+    }
+    let skinned = skin.skin(&joint, &acc, 2);
+    let (nt, nl) = (l.tube_vertex_count(), l.leaf_vertex_count());
+    let stride = l.params.sides as usize + 1;
+    for (k, p) in poses.iter().enumerate() {
+        let meshed = l.mesh(&t, p);
+        for (x, y) in meshed.leaves.iter().zip(&skinned.leaves[k * nl..(k + 1) * nl]) {
+            assert!((pos(x) - pos(y)).length() <= 1e-5 * h, "instance {k}: leaf vertex off");
+        }
+        let tubes = &skinned.tubes[k * nt..(k + 1) * nt];
+        for (r, ring) in l.rings.iter().enumerate() {
+            if ring.t == 0.0 {
+                let c: Vec3 = (0..stride - 1).map(|j| pos(&tubes[r * stride + j])).sum::<Vec3>() / (stride - 1) as f32;
+                let want = p.start[ring.segment as usize];
+                assert!((c - want).length() <= 1e-4 * h, "instance {k}: joint ring {r} off by {}", (c - want).length());
+            }
+        }
+        assert!(tubes.iter().all(|v| (Vec3::from_array(v.normal).length() - 1.0).abs() < 1e-4));
+    }
+    assert_ne!(skinned.leaves[..nl], skinned.leaves[nl..], "the two instances moved alike");
+}

@@ -19,6 +19,7 @@ pub mod pose;
 pub mod render;
 pub mod segment_ends;
 pub mod shader;
+pub mod skin;
 pub mod trunk_noise;
 pub mod wind_sample;
 

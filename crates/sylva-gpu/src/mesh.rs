@@ -43,7 +43,7 @@ pub struct GpuMesh {
     segment_count: usize,
 }
 
-fn vertex_buffer(ctx: &GpuContext, label: &'static str, len: usize) -> Result<wgpu::Buffer, GpuError> {
+pub(crate) fn vertex_buffer(ctx: &GpuContext, label: &'static str, len: usize) -> Result<wgpu::Buffer, GpuError> {
     let bytes = (len * std::mem::size_of::<RawVertex>()).max(32) as u64;
     let limit = ctx.device.limits().max_storage_buffer_binding_size;
     if bytes > limit {
@@ -57,7 +57,7 @@ fn vertex_buffer(ctx: &GpuContext, label: &'static str, len: usize) -> Result<wg
     }))
 }
 
-fn index_buffer(ctx: &GpuContext, label: &'static str, indices: &[u32]) -> wgpu::Buffer {
+pub(crate) fn index_buffer(ctx: &GpuContext, label: &'static str, indices: &[u32]) -> wgpu::Buffer {
     let mut data = indices.to_vec();
     if data.is_empty() {
         data.push(0);
@@ -138,6 +138,22 @@ impl GpuMesh {
         self.record_pose(ctx, &mut encoder, tree, pose);
         ctx.queue.submit([encoder.finish()]);
         self.read(ctx)
+    }
+
+    /// What the renderer draws: this mesh once per instance of `instances`.
+    pub fn draw_item<'a>(&'a self, instances: &'a wgpu::Buffer, instance_count: u32) -> crate::render::DrawItem<'a> {
+        let buffers = |vertices, indices, index_count| crate::render::MeshBuffers {
+            vertices,
+            indices,
+            index_count,
+            per_instance_vertices: 0,
+        };
+        crate::render::DrawItem {
+            bark: buffers(&self.tube_vertices, &self.tube_indices, self.tube_index_count),
+            leaves: buffers(&self.leaf_vertices, &self.leaf_indices, self.leaf_index_count),
+            instances,
+            instance_count,
+        }
     }
 
     /// Reads the current vertices back.

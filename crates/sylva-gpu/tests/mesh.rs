@@ -89,3 +89,31 @@ fn gpu_mesh_reads_a_gpu_methods_pose_without_a_round_trip() {
         assert!(rest.tubes.iter().zip(&on_gpu.tubes).any(|(a, b)| a.position != b.position));
     }
 }
+
+#[test]
+fn gpu_skinning_matches_cpu_for_many_instances() {
+    use sylva_core::mesh::SkinLayout;
+    use sylva_gpu::skin::GpuSkin;
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(77);
+    let t = SpeciesSource::resolve("quaking_aspen").unwrap().generate(1, &Default::default(), None).unwrap();
+    let layout = MeshLayout::new(&t, MeshParams::default()).unwrap();
+    let skin = SkinLayout::new(&layout);
+    let instances = 5u32;
+    let (mut joint, mut acc) = (Vec::new(), Vec::new());
+    for _ in 0..instances {
+        let (j, a) = sylva_core::mesh::pose_buffers(&t, &random_pose(&t, &mut rng));
+        joint.extend(j);
+        acc.extend(a);
+    }
+    let cpu = skin.skin(&joint, &acc, instances);
+    let g = GpuSkin::new(ctx, &layout, &skin, instances).unwrap();
+    let (jb, ab) =
+        (sylva_gpu::kernel::upload(ctx, "j", &joint).unwrap(), sylva_gpu::kernel::upload(ctx, "a", &acc).unwrap());
+    let mut e = ctx.device.create_command_encoder(&Default::default());
+    g.record(ctx, &mut e, &jb, &ab);
+    ctx.queue.submit([e.finish()]);
+    let gpu = g.read(ctx).unwrap();
+    let worst = compare(&t, &cpu, &gpu, "skinning");
+    println!("skinning {instances} aspens: worst {worst:.1e} × height");
+}

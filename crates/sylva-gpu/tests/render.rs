@@ -15,7 +15,7 @@ use sylva_core::animate::Pose;
 use sylva_core::mesh::{MeshLayout, MeshParams};
 use sylva_core::species::SpeciesSource;
 use sylva_gpu::mesh::GpuMesh;
-use sylva_gpu::render::{Camera, DrawItem, Instance, Lighting, RENDER_WGSL, RawGlobals, RenderSettings, Renderer};
+use sylva_gpu::render::{Camera, Instance, Lighting, RENDER_WGSL, RawGlobals, RenderSettings, Renderer};
 
 /// Largest mean absolute difference per channel (0–255) from the reference.
 const MEAN_TOLERANCE: f64 = 1.5;
@@ -91,7 +91,7 @@ fn small_scene_matches_its_golden_image() {
     let globals = renderer.globals(&camera, &light, (Vec3::new(-6.0, 0.0, -7.0), Vec3::new(3.0, 5.0, 3.0)));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     mesh.record_pose(ctx, &mut encoder, &t, &Pose::rest(&t));
-    let items = [DrawItem { mesh: &mesh, instances: &instances, instance_count: 2 }];
+    let items = [mesh.draw_item(&instances, 2)];
     renderer.record(ctx, &mut encoder, &globals, &items);
     let rgba = renderer.read_image(ctx, encoder).unwrap();
     assert_eq!(rgba.len(), (w * h * 4) as usize);

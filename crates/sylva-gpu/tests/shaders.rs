@@ -391,3 +391,32 @@ fn mesh_structs_match_their_wgsl_twins() {
         ],
     );
 }
+
+#[test]
+fn skin_structs_match_their_wgsl_twins() {
+    use sylva_core::mesh::{RawSkin, RawSkinInfo};
+    use sylva_gpu::shader::{MESH, NOISE, QUAT, SKIN_VERTICES};
+    let src = compose(&[QUAT, NOISE, MESH, SKIN_VERTICES]);
+    check_in(
+        &src,
+        "Skin",
+        size_of::<RawSkin>(),
+        &[
+            ("bone0", offset_of!(RawSkin, bone0)),
+            ("bone1", offset_of!(RawSkin, bone1)),
+            ("weight", offset_of!(RawSkin, weight)),
+            ("_pad", offset_of!(RawSkin, _pad)),
+        ],
+    );
+    check_in(
+        &src,
+        "SkinInfo",
+        size_of::<RawSkinInfo>(),
+        &[
+            ("vertices", offset_of!(RawSkinInfo, vertices)),
+            ("segments", offset_of!(RawSkinInfo, segments)),
+            ("instances", offset_of!(RawSkinInfo, instances)),
+            ("_pad", offset_of!(RawSkinInfo, _pad)),
+        ],
+    );
+}

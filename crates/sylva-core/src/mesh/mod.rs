@@ -32,6 +32,10 @@
 //! references `cpu::mesh_tubes` and `cpu::mesh_leaves` are the twins of
 //! `sylva-gpu`'s `mesh_tubes.wgsl` and `mesh_leaves.wgsl` (one invocation per vertex).
 
+pub mod skin;
+
+pub use skin::{RawSkin, RawSkinInfo, SkinLayout};
+
 use crate::animate::Pose;
 use crate::model::{NONE, RawLeaf, RawSegment, Tree};
 use bytemuck::{Pod, Zeroable};

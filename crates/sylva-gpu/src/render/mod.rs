@@ -8,7 +8,6 @@
 //! resolve → read back as RGBA8. The render target is a texture, so an interactive window
 //! can reuse every pipeline with its surface's format instead.
 
-use crate::mesh::GpuMesh;
 use crate::{GpuContext, GpuError};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
@@ -144,12 +143,28 @@ pub struct RawGlobals {
     pub params: [f32; 4],
 }
 
-/// A mesh drawn once per instance.
+/// Vertex and index buffers of one material.
+#[derive(Debug, Clone, Copy)]
+pub struct MeshBuffers<'a> {
+    /// Vertices ([`sylva_core::mesh::RawVertex`]), written by a mesh or skinning kernel.
+    pub vertices: &'a wgpu::Buffer,
+    /// Triangle indices.
+    pub indices: &'a wgpu::Buffer,
+    /// Number of indices.
+    pub index_count: u32,
+    /// 0: every instance draws the same vertices; n: instance k draws vertices `k × n ..`
+    /// (skinned instances, each with its own pose).
+    pub per_instance_vertices: u32,
+}
+
+/// A tree drawn once per instance: bark and leaves.
 #[derive(Debug, Clone, Copy)]
 pub struct DrawItem<'a> {
-    /// The tree's mesh (vertex buffers written by the mesh kernels).
-    pub mesh: &'a GpuMesh,
-    /// Its instances (from [`Renderer::instances`]).
+    /// Bark.
+    pub bark: MeshBuffers<'a>,
+    /// Leaves.
+    pub leaves: MeshBuffers<'a>,
+    /// Instance transforms (from [`Renderer::instances`]).
     pub instances: &'a wgpu::Buffer,
     /// How many.
     pub instance_count: u32,
@@ -491,18 +506,21 @@ impl Renderer {
                 pass.set_pipeline(p);
             }
             for item in items {
-                let (vb, ib, count) = if is_leaf {
-                    (&item.mesh.leaf_vertices, &item.mesh.leaf_indices, item.mesh.leaf_index_count)
-                } else {
-                    (&item.mesh.tube_vertices, &item.mesh.tube_indices, item.mesh.tube_index_count)
-                };
-                if count == 0 || item.instance_count == 0 {
+                let m = if is_leaf { &item.leaves } else { &item.bark };
+                if m.index_count == 0 || item.instance_count == 0 {
                     continue;
                 }
-                pass.set_vertex_buffer(0, vb.slice(..));
+                pass.set_vertex_buffer(0, m.vertices.slice(..));
                 pass.set_vertex_buffer(1, item.instances.slice(..));
-                pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..count, 0, 0..item.instance_count);
+                pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
+                if m.per_instance_vertices == 0 {
+                    pass.draw_indexed(0..m.index_count, 0, 0..item.instance_count);
+                } else {
+                    for k in 0..item.instance_count {
+                        let base = (k * m.per_instance_vertices) as i32;
+                        pass.draw_indexed(0..m.index_count, base, k..k + 1);
+                    }
+                }
             }
         }
     }

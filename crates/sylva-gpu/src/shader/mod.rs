@@ -55,6 +55,8 @@ pub const MESH: &str = include_str!("mesh.wgsl");
 pub const MESH_TUBES: &str = include_str!("mesh_tubes.wgsl");
 /// Kernel: leaf-polygon vertices.
 pub const MESH_LEAVES: &str = include_str!("mesh_leaves.wgsl");
+/// Kernel: two-bone skinning of a rest mesh, instance-major.
+pub const SKIN_VERTICES: &str = include_str!("skin_vertices.wgsl");
 /// Kernel: trunk noise bands at many (t, tree) samples.
 pub const TRUNK_NOISE: &str = include_str!("trunk_noise.wgsl");
 
@@ -79,6 +81,7 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("hsm_pose", &[QUAT, TREE, HSM, HSM_POSE]),
     ("mesh_tubes", &[QUAT, TREE, NOISE, MESH, MESH_TUBES]),
     ("mesh_leaves", &[QUAT, TREE, NOISE, MESH, MESH_LEAVES]),
+    ("skin_vertices", &[QUAT, NOISE, MESH, SKIN_VERTICES]),
 ];
 
 /// Concatenates WGSL sources into one module.

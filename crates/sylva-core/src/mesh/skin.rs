@@ -1,0 +1,114 @@
+//! Skinning (Zioma §6.5): a static rest mesh whose vertices follow the per-segment pose by
+//! linear blend skinning with at most two bones — the cheap path for forests, where one
+//! rest mesh serves every instance and only each instance's pose differs.
+//!
+//! Bones are segments; a bone's transform maps rest to pose rigidly,
+//! `x ↦ joint_b + D_b (x − rest_b)` (joint position, accumulated rotation, rest joint), the
+//! same transform that carries a leaf in [`crate::cpu::mesh_leaves`]. A bark vertex on a
+//! ring at parameter t of segment i blends segment i with its neighbour in the stem toward
+//! the nearer joint — weight ½ − t of the previous segment for t < ½, t − ½ of the next for
+//! t > ½ — so a joint ring is exactly half each and the skin bends smoothly there. A leaf
+//! vertex follows its segment alone.
+//!
+//! The CPU reference `cpu::skin_vertices` is the twin of `skin_vertices.wgsl`; both write
+//! instance-major output (`instance × vertices + vertex`) from instance-major poses.
+
+use super::{MeshLayout, RawVertex};
+use crate::model::NONE;
+use bytemuck::{Pod, Zeroable};
+
+/// Two bones and the second's weight, 16 bytes. WGSL: `struct Skin` in `skin_vertices.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawSkin {
+    /// First bone (segment), weight `1 − weight`.
+    pub bone0: u32,
+    /// Second bone (segment), weight `weight`.
+    pub bone1: u32,
+    /// Weight of the second bone, 0…½.
+    pub weight: f32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+/// Sizes for the kernel, 16 bytes. WGSL: `struct SkinInfo`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawSkinInfo {
+    /// Vertices of one instance.
+    pub vertices: u32,
+    /// Segments of one instance (the pose stride).
+    pub segments: u32,
+    /// Instances.
+    pub instances: u32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+/// A rest mesh with its bone weights, bark and leaves in separate ranges (as
+/// [`super::MeshFrame`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SkinLayout {
+    /// Rest bark vertices.
+    pub tube_rest: Vec<RawVertex>,
+    /// Bark bones.
+    pub tube_skin: Vec<RawSkin>,
+    /// Rest leaf vertices.
+    pub leaf_rest: Vec<RawVertex>,
+    /// Leaf bones.
+    pub leaf_skin: Vec<RawSkin>,
+    /// Rest joint of every segment (w = 0): the bones' rest frames.
+    pub rest_joint: Vec<[f32; 4]>,
+    /// Segments per instance.
+    pub segments: u32,
+}
+
+impl SkinLayout {
+    /// The rest mesh of `layout` (meshed from the rest pose) and its weights.
+    pub fn new(layout: &MeshLayout) -> Self {
+        let n = layout.segments.len();
+        let joint: Vec<[f32; 4]> = layout.segments.iter().map(|s| [s.start[0], s.start[1], s.start[2], 0.0]).collect();
+        let acc = vec![[0.0, 0.0, 0.0, 1.0]; n];
+        let rest = layout.mesh_raw(&joint, &acc);
+        let stride = layout.params.sides as usize + 1;
+        let mut tube_skin = Vec::with_capacity(rest.tubes.len());
+        for r in &layout.rings {
+            let (bone1, weight) = if r.t < 0.5 && r.prev != NONE {
+                (r.prev, 0.5 - r.t)
+            } else if r.t > 0.5 && r.next != NONE {
+                (r.next, r.t - 0.5)
+            } else {
+                (r.segment, 0.0)
+            };
+            tube_skin.extend(std::iter::repeat_n(RawSkin { bone0: r.segment, bone1, weight, _pad: 0 }, stride));
+        }
+        let leaf_stride = layout.params.leaf_sides as usize + 1;
+        let leaf_skin = layout
+            .leaves
+            .iter()
+            .flat_map(|l| {
+                std::iter::repeat_n(RawSkin { bone0: l.segment, bone1: l.segment, weight: 0.0, _pad: 0 }, leaf_stride)
+            })
+            .collect();
+        Self {
+            tube_rest: rest.tubes,
+            tube_skin,
+            leaf_rest: rest.leaves,
+            leaf_skin,
+            rest_joint: joint,
+            segments: n as u32,
+        }
+    }
+
+    /// Skins `instances` poses (instance-major joints and rotations) on the CPU: bark and
+    /// leaves, instance-major.
+    pub fn skin(&self, joint: &[[f32; 4]], acc: &[[f32; 4]], instances: u32) -> super::MeshFrame {
+        let run = |rest: &[RawVertex], skin: &[RawSkin]| {
+            let info = RawSkinInfo { vertices: rest.len() as u32, segments: self.segments, instances, _pad: 0 };
+            let mut out = vec![RawVertex::zeroed(); rest.len() * instances as usize];
+            crate::cpu::skin_vertices(&info, rest, skin, &self.rest_joint, joint, acc, &mut out);
+            out
+        };
+        super::MeshFrame { tubes: run(&self.tube_rest, &self.tube_skin), leaves: run(&self.leaf_rest, &self.leaf_skin) }
+    }
+}

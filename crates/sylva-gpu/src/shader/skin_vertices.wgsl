@@ -1,0 +1,45 @@
+// skin_vertices: linear blend skinning with two bones (Zioma §6.5), one output vertex per
+// invocation, instance-major: out[instance * vertices + v].
+// CPU twin: sylva_core::cpu::skin_vertices (same bindings, same loop body).
+
+struct Skin {
+    bone0: u32,
+    bone1: u32,
+    weight: f32,
+    _pad: u32,
+}
+
+struct SkinInfo {
+    vertices: u32,
+    segments: u32,
+    instances: u32,
+    _pad: u32,
+}
+
+@group(0) @binding(0) var<storage, read> info: SkinInfo;
+@group(0) @binding(1) var<storage, read> rest: array<Vertex>;
+@group(0) @binding(2) var<storage, read> skin: array<Skin>;
+@group(0) @binding(3) var<storage, read> rest_joint: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> joint: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> acc: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read_write> out: array<Vertex>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let id = gid.x + gid.y * nwg.x * 64u;
+    if (id >= info.vertices * info.instances) {
+        return;
+    }
+    let inst = id / info.vertices;
+    let v = id % info.vertices;
+    let base = inst * info.segments;
+    let x = rest[v].position;
+    let nrm = rest[v].normal;
+    let s = skin[v];
+    let w = s.weight;
+    let p0 = joint[base + s.bone0].xyz + quat_rotate(acc[base + s.bone0], x - rest_joint[s.bone0].xyz);
+    let p1 = joint[base + s.bone1].xyz + quat_rotate(acc[base + s.bone1], x - rest_joint[s.bone1].xyz);
+    let p = p0 * (1.0 - w) + p1 * w;
+    let normal = normalize(quat_rotate(acc[base + s.bone0], nrm) * (1.0 - w) + quat_rotate(acc[base + s.bone1], nrm) * w);
+    out[id] = Vertex(p, rest[v].u, normal, rest[v].v);
+}
