@@ -16,13 +16,14 @@ use sylva_core::animate::akagi::{Akagi, AkagiParams, AkagiState};
 use sylva_core::animate::hsm::{Hsm, HsmParams, HsmState};
 use sylva_core::animate::skjermo::{Skjermo, SkjermoParams, SkjermoState};
 use sylva_core::animate::zioma::{Zioma, ZiomaInstance, ZiomaParams};
-use sylva_core::mesh::{MeshLayout, MeshParams, SkinLayout, pose_buffers};
+use sylva_core::mesh::{DeformLayout, DeformerParams, MeshLayout, MeshParams, SkinLayout, pose_buffers};
 use sylva_core::scene::{BackendChoice, MethodName, Scene};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 use sylva_core::wind::raw::{RawField, RawWave};
 use sylva_core::{Limits, Tree};
 use sylva_gpu::GpuContext;
+use sylva_gpu::deform::GpuDeform;
 use sylva_gpu::mesh::GpuMesh;
 use sylva_gpu::render::{Camera, DrawItem, Instance, Lighting, RenderSettings, Renderer};
 use sylva_gpu::skin::GpuSkin;
@@ -277,10 +278,23 @@ impl ZiomaForest {
 
 /// A tree of the scene as it is animated and drawn.
 enum Drawn {
-    /// One animated mesh, drawn once per instance.
-    Single(Anim, GpuMesh),
+    /// One animated mesh, drawn once per instance; Skjermo's trees with the deformer's
+    /// bark.
+    Single(Box<(Anim, GpuMesh, Option<GpuDeform>)>),
     /// Skinned instances, each with its own pose.
-    Forest(ZiomaForest),
+    Forest(Box<ZiomaForest>),
+}
+
+impl Anim {
+    /// Records Skjermo's deformer on the method's current curves (§3: the bark follows the
+    /// animated Béziers); nothing for other methods.
+    fn record_deform(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, deform: &GpuDeform) {
+        match self {
+            Self::SkjermoCpu(_, s) => deform.record_state(ctx, encoder, &s.stems),
+            Self::SkjermoGpu(g) => deform.record(ctx, encoder, g.stems_buffer(), g.state_buffer()),
+            _ => {}
+        }
+    }
 }
 
 /// A temporary file renamed into place on success and removed otherwise.
@@ -435,7 +449,14 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
             encoder: &mut wgpu::CommandEncoder,
         ) -> Result<()> {
             match &mut self.drawn {
-                Drawn::Single(anim, mesh) => anim.advance_and_mesh(ctx, &self.tree, wind, t, dt, steps, mesh, encoder),
+                Drawn::Single(single) => {
+                    let (anim, mesh, deform) = &mut **single;
+                    anim.advance_and_mesh(ctx, &self.tree, wind, t, dt, steps, mesh, encoder)?;
+                    if let Some(d) = deform {
+                        anim.record_deform(ctx, encoder, d);
+                    }
+                    Ok(())
+                }
                 Drawn::Forest(f) => {
                     f.frame(ctx, &self.tree, wind, t, encoder);
                     Ok(())
@@ -464,7 +485,6 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
             ..defaults
         };
         let layout = MeshLayout::new(&tree, params)?;
-        triangles += layout.triangle_count() * (1 + st.copies.len());
         let tint = Vec3::from_array(st.tint.unwrap_or([0.28, 0.50, 0.12]));
         let mut inst = vec![instance(st.position, st.yaw_deg, st.scale, tint)];
         inst.extend(st.copies.iter().map(|c| instance(c.position, c.yaw_deg, c.scale, tint * 1.05)));
@@ -484,20 +504,35 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         let label = st.label.clone().unwrap_or_else(|| {
             format!("{} · {} ({})", tree.name.replace('_', " "), st.method.as_str(), if gpu { "GPU" } else { "CPU" })
         });
+        let mut bark_triangles = layout.tube_indices.len() / 3;
+        let drawn = if st.method == MethodName::Zioma && inst.len() > 1 {
+            Drawn::Forest(Box::new(ZiomaForest::new(ctx, &tree, &layout, &inst, gpu, st.seed, &wind)?))
+        } else {
+            let deform = if st.method == MethodName::Skjermo {
+                let grid = DeformLayout::new(&tree, DeformerParams { sides: params.sides, ..Default::default() })?;
+                bark_triangles = grid.triangle_count();
+                let m = Skjermo::new(&tree, SkjermoParams::default());
+                Some(GpuDeform::new(ctx, &grid, &m.stems)?)
+            } else {
+                None
+            };
+            Drawn::Single(Box::new((
+                Anim::new(ctx, &tree, st.method, gpu, st.seed, &wind)?,
+                GpuMesh::new(ctx, &layout)?,
+                deform,
+            )))
+        };
+        let tree_triangles = bark_triangles + layout.leaf_indices.len() / 3;
+        triangles += tree_triangles * inst.len();
         println!(
             "  {:<18} {:>6} segments {:>7} leaves  {:>8} triangles × {} instance(s)  {}",
             tree.name,
             tree.segments.len(),
             tree.leaves.len(),
-            layout.triangle_count(),
+            tree_triangles,
             inst.len(),
             label
         );
-        let drawn = if st.method == MethodName::Zioma && inst.len() > 1 {
-            Drawn::Forest(ZiomaForest::new(ctx, &tree, &layout, &inst, gpu, st.seed, &wind)?)
-        } else {
-            Drawn::Single(Anim::new(ctx, &tree, st.method, gpu, st.seed, &wind)?, GpuMesh::new(ctx, &layout)?)
-        };
         // Poses are in the tree's own frame (skinned instances sample the wind at their
         // placement and turn it by their yaw); the instance transform places them.
         let instances = Renderer::instances(ctx, &inst);
@@ -617,7 +652,14 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         let items: Vec<DrawItem<'_>> = entries
             .iter()
             .map(|e| match &e.drawn {
-                Drawn::Single(_, mesh) => mesh.draw_item(&e.instances, e.count),
+                Drawn::Single(single) => {
+                    let (_, mesh, deform) = &**single;
+                    let mut item = mesh.draw_item(&e.instances, e.count);
+                    if let Some(d) = deform {
+                        item.bark = d.bark();
+                    }
+                    item
+                }
                 Drawn::Forest(f) => f.skin.draw_item(&e.instances),
             })
             .collect();

@@ -245,3 +245,142 @@ fn skinning_follows_the_pose_and_keeps_joint_rings_on_their_joints() {
     }
     assert_ne!(skinned.leaves[..nl], skinned.leaves[nl..], "the two instances moved alike");
 }
+
+mod deformer {
+    use super::*;
+    use sylva_core::animate::skjermo::{Skjermo, SkjermoParams, bezier};
+    use sylva_core::mesh::{DeformLayout, DeformerParams, RawDeformShape, deform_radius};
+    use sylva_core::wind::WindScene;
+
+    fn deform(
+        layout: &DeformLayout,
+        m: &Skjermo,
+        state: &[sylva_core::animate::skjermo::RawSkjermoState],
+    ) -> Vec<RawVertex> {
+        let mut out = vec![bytemuck::Zeroable::zeroed(); layout.vertex_count()];
+        sylva_core::cpu::skjermo_deform(&layout.info(), &layout.rings, &layout.shapes, &m.stems, state, &mut out);
+        out
+    }
+
+    fn curve(m: &Skjermo, state: &[sylva_core::animate::skjermo::RawSkjermoState], k: usize) -> [Vec3; 4] {
+        [0, 1, 2, 3].map(|j| Vec3::from_slice(&m.stems[k].rest[j][..3]) + Vec3::from_slice(&state[k].delta[j][..3]))
+    }
+
+    /// Without lobes the ring's centroid is the Bézier point (the handles cancel over a
+    /// full turn); at the base the ring's radius is r (1 + flare); normals are unit and point
+    /// away from the curve — at rest and after the wind has bent the curves.
+    #[test]
+    fn branches_follow_their_current_bezier() {
+        let t = tree("black_tupelo");
+        let h = t.height();
+        let p = DeformerParams { trunk_lobe_depth: 0.0, ..Default::default() };
+        let layout = DeformLayout::new(&t, p).unwrap();
+        let m = Skjermo::new(&t, SkjermoParams::default());
+        let mut state = m.rest_state(&t);
+        let wind = WindScene::resolve("gusty").unwrap();
+        let (fields, waves) = wind.pack();
+        let stride = p.sides as usize + 1;
+        for round in 0..2 {
+            let v = deform(&layout, &m, &state.stems);
+            for (r, ring) in layout.rings.iter().enumerate() {
+                let k = ring.stem as usize;
+                let c = curve(&m, &state.stems, k);
+                let centre: Vec3 = (0..stride - 1).map(|j| pos(&v[r * stride + j])).sum::<Vec3>() / (stride - 1) as f32;
+                let want = bezier(&c, ring.v);
+                assert!(
+                    (centre - want).length() <= 1e-4 * h,
+                    "round {round} ring {r}: centroid off by {}",
+                    (centre - want).length()
+                );
+                for j in 0..stride {
+                    let x = &v[r * stride + j];
+                    let n = Vec3::from_array(x.normal);
+                    assert!((n.length() - 1.0).abs() < 1e-4);
+                    // Rings thinner than f32 resolves at their height are noise.
+                    let resolvable = (pos(x) - centre).length() > 64.0 * f32::EPSILON * centre.length();
+                    assert!(
+                        !resolvable || n.dot(pos(x) - centre) > 0.0,
+                        "round {round} ring {r} (stem {k}, v {}, shape {:?}, curve {c:?}): normal points inward",
+                        ring.v,
+                        layout.shapes[k]
+                    );
+                }
+                if ring.v == 0.0 {
+                    let s = &layout.shapes[k];
+                    let want_r = s.radius * (1.0 + s.flare);
+                    let got = (pos(&v[r * stride]) - centre).length();
+                    assert!((got - want_r).abs() <= 1e-3 * want_r + 1e-5, "stem {k}: base radius {got} vs {want_r}");
+                }
+            }
+            // Bend the curves and check again.
+            for _ in 0..30 {
+                m.step(&t, &fields, &waves, &mut state, 1.0 / 30.0);
+            }
+            assert!(state.stems.iter().any(|s| s.delta[3][0] != 0.0), "the wind bent nothing");
+        }
+    }
+
+    /// The Jacobian normals (eq. 10) agree with finite differences of the surface.
+    #[test]
+    fn jacobian_normals_match_finite_differences() {
+        let t = tree("quaking_aspen");
+        let p = DeformerParams {
+            sides: 64,
+            rows_per_segment: 16,
+            trunk_lobe_depth: 0.1,
+            bulges: 3.0,
+            bulge_depth: 0.05,
+            ..Default::default()
+        };
+        let layout = DeformLayout::new(&t, p).unwrap();
+        let m = Skjermo::new(&t, SkjermoParams::default());
+        let state = m.rest_state(&t);
+        let v = deform(&layout, &m, &state.stems);
+        let stride = p.sides as usize + 1;
+        let mut worst = 0.0f32;
+        // The trunk (stem 0): rings 1..rows-1, every side.
+        let rows = layout.rings.iter().filter(|r| r.stem == 0).count();
+        for r in 1..rows - 1 {
+            for j in 0..p.sides as usize {
+                let at = |rr: usize, jj: usize| pos(&v[rr * stride + (jj + p.sides as usize) % p.sides as usize]);
+                let d_theta = at(r, j + 1) - at(r, j + p.sides as usize - 1);
+                let d_u = at(r + 1, j) - at(r - 1, j);
+                let fd = d_theta.cross(d_u).normalize();
+                let n = Vec3::from_array(v[r * stride + j].normal);
+                worst = worst.max(1.0 - n.dot(fd));
+            }
+        }
+        assert!(worst < 0.02, "analytic and finite-difference normals differ: 1 − cos = {worst}");
+    }
+
+    #[test]
+    fn radius_functions_follow_equations_2_to_5() {
+        let s = RawDeformShape {
+            radius: 0.5,
+            taper: 2.0,
+            flare: 0.3,
+            bulges: 3.0,
+            bulge_depth: 0.1,
+            lobes: 5.0,
+            lobe_depth: 0.2,
+            lobe_fade: 1.0,
+            v_floor: 0.9f32.powf(0.5),
+            _pad: [0.0; 3],
+        };
+        let (v, th) = (0.3f32, 0.7f32);
+        let want = 0.5
+            * (1.0 - v * v)
+            * (0.3 / 100.0 * 100f32.powf(1.0 - 8.0 * v) + 1.0)
+            * (1.0 + 0.1 * (3.0 * std::f32::consts::TAU * v).sin())
+            * (1.0 + 0.2 * (5.0 * th).sin() * (1.0 - v));
+        let (r, r_v, r_t) = deform_radius(&s, v, th);
+        assert!((r - want).abs() < 1e-5, "{r} vs {want}");
+        let e = 1e-3;
+        let fd_v = (deform_radius(&s, v + e, th).0 - deform_radius(&s, v - e, th).0) / (2.0 * e);
+        let fd_t = (deform_radius(&s, v, th + e).0 - deform_radius(&s, v, th - e).0) / (2.0 * e);
+        assert!((r_v - fd_v).abs() < 1e-2 * fd_v.abs().max(1.0), "{r_v} vs {fd_v}");
+        assert!((r_t - fd_t).abs() < 1e-2 * fd_t.abs().max(1.0), "{r_t} vs {fd_t}");
+        // The tip keeps a ring: never below a tenth of the base radius.
+        assert!((deform_radius(&s, 1.0, 0.0).0 - 0.05).abs() < 1e-6);
+    }
+}

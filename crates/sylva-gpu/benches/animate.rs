@@ -190,8 +190,10 @@ fn fk_table(ctx: Option<&'static GpuContext>) {
 /// Zioma's Table 6-1 sizes: 30, 100, 256 and 1,000 instances of an 80-branch tree (a trunk
 /// and 79 side branches of four segments), one pose per frame for every instance: CPU
 /// (rotations + forward kinematics, rayon) and GPU (one dispatch over all instances' segments
-/// and one forward-kinematics pass, waited for). The paper's figures (GeForce 8800 GTX)
-/// include skinning 4,617 vertices per instance, which is the meshing issue's path.
+/// and one forward-kinematics pass, waited for), then skinning (Zioma §6.5) of every
+/// instance's copy of one rest mesh (8-sided tubes, one cross-section per segment: 4,275
+/// vertices against the paper's 4,617): CPU `SkinLayout::skin`, GPU `skin_vertices.wgsl`.
+/// The paper's figures (GeForce 8800 GTX) are pose + skinning.
 fn zioma_instances_table(ctx: Option<&'static GpuContext>, wind: &WindScene) {
     use sylva_core::animate::zioma::ZiomaInstance;
     use sylva_core::{Grammar, LSystemOptions};
@@ -209,10 +211,17 @@ fn zioma_instances_table(ctx: Option<&'static GpuContext>, wind: &WindScene) {
         t.stems.len(),
         t.segments.len()
     );
+    let layout = sylva_core::mesh::MeshLayout::new(
+        &t,
+        sylva_core::mesh::MeshParams { sides: 8, samples: 1, leaves: false, ..Default::default() },
+    )
+    .unwrap();
+    let skin = sylva_core::mesh::SkinLayout::new(&layout);
     println!(
-        "{:>9} {:>9} {:>10} {:>10} {:>10}   paper DX10 (8800 GTX, with skinning)",
-        "instances", "branches", "cpu ms", "gpu ms", "gpu/cpu"
+        "{:>9} {:>9} {:>10} {:>10} {:>10} {:>14} {:>14} {:>10}   paper DX10 (8800 GTX, pose + skinning)",
+        "instances", "branches", "cpu ms", "gpu ms", "gpu/cpu", "cpu+skin ms", "gpu+skin ms", "gpu/cpu"
     );
+    println!("(skinning {} vertices per instance)", skin.tube_rest.len());
     for (count, paper) in [(30usize, 1.34), (100, 3.82), (256, 9.68), (1000, 37.61)] {
         let instances = ZiomaInstance::grid(count, 8.0, 1);
         let mut tt = 0.0;
@@ -221,31 +230,55 @@ fn zioma_instances_table(ctx: Option<&'static GpuContext>, wind: &WindScene) {
             let d = z.rotations_instances(&t, &fields, &waves, tt, &instances);
             std::hint::black_box(sylva_core::animate::Pose::from_rotations_instances(&t, &d));
         });
+        let cpu_skin = time(5, || {
+            tt += 1.0 / 60.0;
+            let d = z.rotations_instances(&t, &fields, &waves, tt, &instances);
+            let (mut joint, mut acc) = (Vec::new(), Vec::new());
+            for p in sylva_core::animate::Pose::from_rotations_instances(&t, &d) {
+                let (j, a) = sylva_core::mesh::pose_buffers(&t, &p);
+                joint.extend(j);
+                acc.extend(a);
+            }
+            std::hint::black_box(skin.skin(&joint, &acc, count as u32));
+        });
         let gpu = ctx.map(|c| {
             let g = GpuZioma::with_instances(c, &t, &z, wind, &instances).unwrap();
-            time(9, || {
+            let pose = time(9, || {
                 tt += 1.0 / 60.0;
                 g.submit(c, &t, &z, tt);
                 c.wait().unwrap();
-            })
+            });
+            // Skinning every instance, unless the output exceeds the device's binding limit.
+            let skinned = sylva_gpu::skin::GpuSkin::new(c, &layout, &skin, count as u32).ok().map(|gs| {
+                time(9, || {
+                    tt += 1.0 / 60.0;
+                    g.submit(c, &t, &z, tt);
+                    let mut e = c.device.create_command_encoder(&Default::default());
+                    gs.record(c, &mut e, g.gpu_pose().joints_buffer(), g.gpu_pose().acc_buffer());
+                    c.queue.submit([e.finish()]);
+                    c.wait().unwrap();
+                })
+            });
+            (pose, skinned)
         });
         let ms = |d: Duration| d.as_secs_f64() * 1e3;
-        match gpu {
-            Some(gd) => println!(
-                "{count:>9} {:>9} {:>10.2} {:>10.2} {:>9.2}×   {paper} ms",
-                count * t.stems.len(),
-                ms(cpu),
-                ms(gd),
-                ms(cpu) / ms(gd)
-            ),
-            None => println!(
-                "{count:>9} {:>9} {:>10.2} {:>10} {:>10}   {paper} ms",
-                count * t.stems.len(),
-                ms(cpu),
-                "–",
-                "–"
-            ),
-        }
+        let cell = |d: Option<Duration>| d.map_or("–".to_string(), |d| format!("{:.2}", ms(d)));
+        let ratio =
+            |a: Duration, b: Option<Duration>| b.map_or("–".to_string(), |b| format!("{:.2}×", ms(a) / ms(b)));
+        let (gpu_pose, gpu_skin) = match gpu {
+            Some((p, s)) => (Some(p), s),
+            None => (None, None),
+        };
+        println!(
+            "{count:>9} {:>9} {:>10.2} {:>10} {:>10} {:>14.2} {:>14} {:>10}   {paper} ms",
+            count * t.stems.len(),
+            ms(cpu),
+            cell(gpu_pose),
+            ratio(cpu, gpu_pose),
+            ms(cpu_skin),
+            cell(gpu_skin),
+            ratio(cpu_skin, gpu_skin),
+        );
     }
 }
 

@@ -12,6 +12,7 @@
 //!   composed into each kernel, never copied.
 
 mod context;
+pub mod deform;
 pub mod hsm;
 pub mod kernel;
 pub mod mesh;

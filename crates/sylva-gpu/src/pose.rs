@@ -446,6 +446,16 @@ pub struct GpuSkjermo {
 }
 
 impl GpuSkjermo {
+    /// Skjermo's per-stem constants on the GPU (`RawSkjermoStem`).
+    pub fn stems_buffer(&self) -> &wgpu::Buffer {
+        &self.stems
+    }
+
+    /// The current per-stem state (`RawSkjermoState`: control-point displacements).
+    pub fn state_buffer(&self) -> &wgpu::Buffer {
+        &self.state[self.current]
+    }
+
     /// The pose seam's buffers on the GPU (for meshing without a round trip).
     pub fn gpu_pose(&self) -> &GpuPose {
         &self.pose

@@ -117,3 +117,45 @@ fn gpu_skinning_matches_cpu_for_many_instances() {
     let worst = compare(&t, &cpu, &gpu, "skinning");
     println!("skinning {instances} aspens: worst {worst:.1e} × height");
 }
+
+/// Skjermo's deformer: GPU vs CPU on every preset, on curves bent by a few seconds of wind
+/// (CPU Skjermo steps), with random grid resolutions.
+#[test]
+fn gpu_deformer_matches_cpu_on_every_preset() {
+    use sylva_core::animate::skjermo::{Skjermo, SkjermoParams};
+    use sylva_core::mesh::{DeformLayout, DeformerParams, RawVertex};
+    use sylva_gpu::deform::GpuDeform;
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(31);
+    let wind = WindScene::resolve("gusty").unwrap();
+    let (fields, waves) = wind.pack();
+    for preset in PRESETS {
+        let t = SpeciesSource::resolve(preset.name).unwrap().generate(2, &Default::default(), None).unwrap();
+        let params = DeformerParams {
+            sides: rng.random_range(5..12),
+            rows_per_segment: rng.random_range(1..4),
+            bulges: rng.random_range(0.0..4.0),
+            bulge_depth: rng.random_range(0.0..0.1),
+            ..Default::default()
+        };
+        let layout = DeformLayout::new(&t, params).unwrap();
+        let m = Skjermo::new(&t, SkjermoParams::default());
+        let mut state = m.rest_state(&t);
+        for _ in 0..rng.random_range(10..40) {
+            m.step(&t, &fields, &waves, &mut state, 1.0 / 30.0);
+        }
+        let mut cpu = vec![bytemuck::Zeroable::zeroed(); layout.vertex_count()];
+        sylva_core::cpu::skjermo_deform(
+            &layout.info(),
+            &layout.rings,
+            &layout.shapes,
+            &m.stems,
+            &state.stems,
+            &mut cpu,
+        );
+        let gpu: Vec<RawVertex> = GpuDeform::new(ctx, &layout, &m.stems).unwrap().deform(ctx, &state.stems).unwrap();
+        let frame = |v: Vec<RawVertex>| MeshFrame { tubes: v, leaves: Vec::new() };
+        let worst = compare(&t, &frame(cpu), &frame(gpu), &format!("deformer {}", preset.name));
+        println!("deformer {}: {} vertices, worst {worst:.1e} × height", preset.name, layout.vertex_count());
+    }
+}

@@ -420,3 +420,38 @@ fn skin_structs_match_their_wgsl_twins() {
         ],
     );
 }
+
+#[test]
+fn deformer_structs_match_their_wgsl_twins() {
+    use sylva_core::mesh::{RawDeformRing, RawDeformShape};
+    use sylva_gpu::shader::{MESH, NOISE, QUAT, SKJERMO, SKJERMO_DEFORM};
+    let src = compose(&[QUAT, TREE, NOISE, MESH, SKJERMO, SKJERMO_DEFORM]);
+    check_in(
+        &src,
+        "DeformShape",
+        size_of::<RawDeformShape>(),
+        &[
+            ("radius", offset_of!(RawDeformShape, radius)),
+            ("taper", offset_of!(RawDeformShape, taper)),
+            ("flare", offset_of!(RawDeformShape, flare)),
+            ("bulges", offset_of!(RawDeformShape, bulges)),
+            ("bulge_depth", offset_of!(RawDeformShape, bulge_depth)),
+            ("lobes", offset_of!(RawDeformShape, lobes)),
+            ("lobe_depth", offset_of!(RawDeformShape, lobe_depth)),
+            ("lobe_fade", offset_of!(RawDeformShape, lobe_fade)),
+            ("v_floor", offset_of!(RawDeformShape, v_floor)),
+            ("_pad", offset_of!(RawDeformShape, _pad)),
+        ],
+    );
+    check_in(
+        &src,
+        "DeformRing",
+        size_of::<RawDeformRing>(),
+        &[
+            ("stem", offset_of!(RawDeformRing, stem)),
+            ("v", offset_of!(RawDeformRing, v)),
+            ("tex_v", offset_of!(RawDeformRing, tex_v)),
+            ("_pad", offset_of!(RawDeformRing, _pad)),
+        ],
+    );
+}

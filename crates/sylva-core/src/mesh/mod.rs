@@ -32,8 +32,10 @@
 //! references `cpu::mesh_tubes` and `cpu::mesh_leaves` are the twins of
 //! `sylva-gpu`'s `mesh_tubes.wgsl` and `mesh_leaves.wgsl` (one invocation per vertex).
 
+pub mod deformer;
 pub mod skin;
 
+pub use deformer::{DeformLayout, DeformerParams, RawDeformRing, RawDeformShape, deform_radius};
 pub use skin::{RawSkin, RawSkinInfo, SkinLayout};
 
 use crate::animate::Pose;

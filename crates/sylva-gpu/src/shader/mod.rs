@@ -57,6 +57,8 @@ pub const MESH_TUBES: &str = include_str!("mesh_tubes.wgsl");
 pub const MESH_LEAVES: &str = include_str!("mesh_leaves.wgsl");
 /// Kernel: two-bone skinning of a rest mesh, instance-major.
 pub const SKIN_VERTICES: &str = include_str!("skin_vertices.wgsl");
+/// Kernel: Skjermo's deformer (grid → branch → bent along the Bézier).
+pub const SKJERMO_DEFORM: &str = include_str!("skjermo_deform.wgsl");
 /// Kernel: trunk noise bands at many (t, tree) samples.
 pub const TRUNK_NOISE: &str = include_str!("trunk_noise.wgsl");
 
@@ -82,6 +84,7 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("mesh_tubes", &[QUAT, TREE, NOISE, MESH, MESH_TUBES]),
     ("mesh_leaves", &[QUAT, TREE, NOISE, MESH, MESH_LEAVES]),
     ("skin_vertices", &[QUAT, NOISE, MESH, SKIN_VERTICES]),
+    ("skjermo_deform", &[QUAT, TREE, NOISE, MESH, SKJERMO, SKJERMO_DEFORM]),
 ];
 
 /// Concatenates WGSL sources into one module.
