@@ -23,6 +23,7 @@
 //! Unknown keys, wrong types and out-of-range values are errors naming the file, line and
 //! field.
 
+use crate::species::{field_line, line_col};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -269,47 +270,6 @@ pub enum SceneError {
     /// The file could not be read.
     #[error("{file}: {message}")]
     Io { file: String, message: String },
-}
-
-fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let col = before.rfind('\n').map_or(before.len(), |i| before.len() - i - 1) + 1;
-    (line, col)
-}
-
-/// Line of a dotted field (`output.fps`, `tree[2].seed`, `wind`) in scene text: the line of
-/// its key, else of its table, else 1.
-fn field_line(text: &str, field: &str) -> usize {
-    let (table, index, key) = match field.split_once('.') {
-        Some((t, k)) => match t.split_once('[') {
-            Some((name, rest)) => (format!("[[{name}]]"), rest.trim_end_matches(']').parse::<usize>().ok(), k),
-            None => (format!("[{t}]"), None, k),
-        },
-        None => (String::new(), None, field),
-    };
-    let key = key.split('[').next().unwrap_or(key);
-    let mut in_table = table.is_empty();
-    let mut seen = 0usize;
-    let mut table_line = 1;
-    for (i, line) in text.lines().enumerate() {
-        let t = line.trim();
-        if t.starts_with('[') {
-            in_table = false;
-            if !table.is_empty() && t.starts_with(&table) {
-                if index.is_none_or(|n| n == seen) {
-                    in_table = true;
-                    table_line = i + 1;
-                }
-                seen += 1;
-            }
-            continue;
-        }
-        if in_table && t.strip_prefix(key).is_some_and(|r| r.trim_start().starts_with('=')) {
-            return i + 1;
-        }
-    }
-    table_line
 }
 
 impl Scene {

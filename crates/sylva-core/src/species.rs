@@ -123,25 +123,26 @@ pub enum SpeciesSource {
 }
 
 /// 1-based line and column of a byte offset.
-fn line_col(text: &str, offset: usize) -> (usize, usize) {
+pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() + 1;
     let col = before.rfind('\n').map_or(before.len(), |i| before.len() - i - 1) + 1;
     (line, col)
 }
 
-/// Line where a dotted field (`level[1].length`, `wood.density`, `scale`) is set in a
-/// species file, or where its table starts if the key is absent (best effort: 1 if unknown).
-fn field_line(text: &str, field: &str) -> usize {
-    let (table, index, key) = if let Some(rest) = field.strip_prefix("level[") {
-        let close = rest.find(']').unwrap_or(0);
-        let n: usize = rest[..close].parse().unwrap_or(0);
-        ("[[level]]", Some(n), rest[close + 1..].trim_start_matches('.'))
-    } else if let Some(rest) = field.strip_prefix("wood.") {
-        ("[wood]", None, rest)
-    } else {
-        ("", None, field)
+/// Line where a dotted field is set in a TOML file: `name[i].key` in the i-th `[[name]]`
+/// table (`level[1].length`), `name.key` in `[name]` (`wood.density`, `output.fps`), `key` at
+/// the top. The line of the table when the key is absent; 1 when nothing matches (best
+/// effort, for error messages).
+pub(crate) fn field_line(text: &str, field: &str) -> usize {
+    let (table, index, key) = match field.split_once('.') {
+        Some((t, k)) => match t.split_once('[') {
+            Some((name, rest)) => (format!("[[{name}]]"), rest.trim_end_matches(']').parse::<usize>().ok(), k),
+            None => (format!("[{t}]"), None, k),
+        },
+        None => (String::new(), None, field),
     };
+    let key = key.split('[').next().unwrap_or(key);
     let mut in_table = table.is_empty();
     let mut seen = 0usize;
     let mut table_line = 1;
@@ -149,7 +150,7 @@ fn field_line(text: &str, field: &str) -> usize {
         let t = line.trim();
         if t.starts_with('[') {
             in_table = false;
-            if !table.is_empty() && t.starts_with(table) {
+            if !table.is_empty() && t.starts_with(&table) {
                 if index.is_none_or(|n| n == seen) {
                     in_table = true;
                     table_line = i + 1;
@@ -158,12 +159,8 @@ fn field_line(text: &str, field: &str) -> usize {
             }
             continue;
         }
-        if in_table && !key.is_empty() {
-            if let Some(rest) = t.strip_prefix(key) {
-                if rest.trim_start().starts_with('=') {
-                    return i + 1;
-                }
-            }
+        if in_table && t.strip_prefix(key).is_some_and(|r| r.trim_start().starts_with('=')) {
+            return i + 1;
         }
     }
     table_line

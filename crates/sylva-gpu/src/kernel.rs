@@ -222,7 +222,12 @@ pub fn read_back<T: Pod>(ctx: &GpuContext, buffer: &wgpu::Buffer, len: usize) ->
     let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
     ctx.queue.submit([encoder.finish()]);
-    let slice = staging.slice(..);
+    map_read(ctx, &staging, |bytes| bytemuck::cast_slice::<u8, T>(bytes).to_vec())
+}
+
+/// Maps a `MAP_READ` buffer (waiting for the GPU), passes its bytes to `read`, unmaps it.
+pub fn map_read<R>(ctx: &GpuContext, buffer: &wgpu::Buffer, read: impl FnOnce(&[u8]) -> R) -> Result<R, GpuError> {
+    let slice = buffer.slice(..);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
@@ -230,8 +235,8 @@ pub fn read_back<T: Pod>(ctx: &GpuContext, buffer: &wgpu::Buffer, len: usize) ->
     ctx.wait()?;
     rx.recv().map_err(|e| GpuError::Map(e.to_string()))?.map_err(|e| GpuError::Map(e.to_string()))?;
     let view = slice.get_mapped_range().map_err(|e| GpuError::Map(e.to_string()))?;
-    let data = bytemuck::cast_slice::<u8, T>(&view).to_vec();
+    let out = read(&view);
     drop(view);
-    staging.unmap();
-    Ok(data)
+    buffer.unmap();
+    Ok(out)
 }

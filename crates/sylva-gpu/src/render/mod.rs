@@ -607,20 +607,12 @@ impl Renderer {
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
         ctx.queue.submit([encoder.finish()]);
-        let slice = self.readback.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        ctx.wait()?;
-        rx.recv().map_err(|e| GpuError::Map(e.to_string()))?.map_err(|e| GpuError::Map(e.to_string()))?;
-        let view = slice.get_mapped_range().map_err(|e| GpuError::Map(e.to_string()))?;
-        let mut out = Vec::with_capacity((w * h * 4) as usize);
-        for row in view.chunks(self.padded_row as usize).take(h as usize) {
-            out.extend_from_slice(&row[..(w * 4) as usize]);
-        }
-        drop(view);
-        self.readback.unmap();
-        Ok(out)
+        crate::kernel::map_read(ctx, &self.readback, |bytes| {
+            let mut out = Vec::with_capacity((w * h * 4) as usize);
+            for row in bytes.chunks(self.padded_row as usize).take(h as usize) {
+                out.extend_from_slice(&row[..(w * 4) as usize]);
+            }
+            out
+        })
     }
 }
