@@ -13,7 +13,8 @@
 use crate::kernel::{Kernel, output, upload};
 use crate::pose::GpuPose;
 use crate::shader::{
-    HSM, HSM_CLUSTERS, HSM_GATHER, HSM_GOALS, HSM_INTEGRATE, HSM_PARTICLES, HSM_POSE, NOISE, QUAT, TREE, WIND,
+    HSM, HSM_ADVANCE, HSM_CLUSTERS, HSM_GATHER, HSM_GOALS, HSM_INTEGRATE, HSM_PARTICLES, HSM_POSE, NOISE, QUAT, TREE,
+    WIND,
 };
 use crate::{GpuContext, GpuError};
 use std::sync::Arc;
@@ -81,8 +82,12 @@ impl GpuHsm {
         let this = Self {
             clusters_kernel: Kernel::cached(ctx, "hsm_clusters", &[QUAT, NOISE, WIND, HSM, HSM_CLUSTERS]),
             goals_kernel: Kernel::cached(ctx, "hsm_goals", &[QUAT, HSM, HSM_GATHER, HSM_GOALS]),
-            integrate_kernel: Kernel::cached(ctx, "hsm_integrate", &[QUAT, HSM, HSM_INTEGRATE]),
-            particles_kernel: Kernel::cached(ctx, "hsm_particles", &[QUAT, HSM, HSM_GATHER, HSM_PARTICLES]),
+            integrate_kernel: Kernel::cached(ctx, "hsm_integrate", &[QUAT, HSM, HSM_ADVANCE, HSM_INTEGRATE]),
+            particles_kernel: Kernel::cached(
+                ctx,
+                "hsm_particles",
+                &[QUAT, HSM, HSM_GATHER, HSM_ADVANCE, HSM_PARTICLES],
+            ),
             fused: method.params.fused,
             pose_kernel: Kernel::cached(ctx, "hsm_pose", &[QUAT, TREE, HSM, HSM_POSE]),
             pose,

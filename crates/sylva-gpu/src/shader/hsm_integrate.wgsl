@@ -1,4 +1,4 @@
-// hsm_integrate (Song §5.2 stage 4), per particle: shape-matching pull, gravity (balanced
+// hsm_integrate (Song §5.2 stage 4), per particle (`hsm_advance`): shape-matching pull, gravity (balanced
 // when prestressed), semi-implicit drag toward its owner cluster's wind, damping, then the
 // position. CPU twin: sylva_core::cpu::hsm::hsm_integrate. Bindings: 0 rest (w = drag
 // factor), 1 owners, 2 cluster state, 3 goals, 4 step, 5 positions, 6 velocities.
@@ -17,12 +17,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if (i >= arrayLength(&rest)) {
         return;
     }
-    let v0 = velocity[i];
-    if (v0.w == 0.0) {
-        return;
-    }
-    let x = position[i];
-    let vel = hsm_velocity(v0.xyz, goal[i], x.xyz, state[owner[i]].wind.xyz, rest[i].w, step);
-    position[i] = vec4<f32>(x.xyz + vel * step.dt, x.w);
-    velocity[i] = vec4<f32>(vel, v0.w);
+    hsm_advance(i, goal[i]);
 }

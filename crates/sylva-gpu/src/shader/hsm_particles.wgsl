@@ -15,12 +15,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if (i >= arrayLength(&rest)) {
         return;
     }
-    let v0 = velocity[i];
-    if (v0.w == 0.0) {
-        return;
-    }
-    let x = position[i];
-    let vel = hsm_velocity(v0.xyz, hsm_particle_goal(i), x.xyz, state[owner[i]].wind.xyz, rest[i].w, step);
-    position[i] = vec4<f32>(x.xyz + vel * step.dt, x.w);
-    velocity[i] = vec4<f32>(vel, v0.w);
+    hsm_advance(i, hsm_particle_goal(i));
 }

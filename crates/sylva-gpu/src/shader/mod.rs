@@ -43,6 +43,8 @@ pub const HSM_CLUSTERS: &str = include_str!("hsm_clusters.wgsl");
 pub const HSM_GATHER: &str = include_str!("hsm_gather.wgsl");
 /// Kernel: HSM stage 3, per-particle goals.
 pub const HSM_GOALS: &str = include_str!("hsm_goals.wgsl");
+/// Stage 4's particle update (`hsm_advance`), shared by two kernels.
+pub const HSM_ADVANCE: &str = include_str!("hsm_advance.wgsl");
 /// Kernel: HSM stage 4, per-particle integration.
 pub const HSM_INTEGRATE: &str = include_str!("hsm_integrate.wgsl");
 /// Kernel: HSM stages 3 and 4 fused, per particle.
@@ -78,8 +80,8 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("skjermo_rotations", &[QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS]),
     ("hsm_clusters", &[QUAT, NOISE, WIND, HSM, HSM_CLUSTERS]),
     ("hsm_goals", &[QUAT, HSM, HSM_GATHER, HSM_GOALS]),
-    ("hsm_integrate", &[QUAT, HSM, HSM_INTEGRATE]),
-    ("hsm_particles", &[QUAT, HSM, HSM_GATHER, HSM_PARTICLES]),
+    ("hsm_integrate", &[QUAT, HSM, HSM_ADVANCE, HSM_INTEGRATE]),
+    ("hsm_particles", &[QUAT, HSM, HSM_GATHER, HSM_ADVANCE, HSM_PARTICLES]),
     ("hsm_pose", &[QUAT, TREE, HSM, HSM_POSE]),
     ("mesh_tubes", &[QUAT, TREE, NOISE, MESH, MESH_TUBES]),
     ("mesh_leaves", &[QUAT, TREE, NOISE, MESH, MESH_LEAVES]),
