@@ -16,8 +16,9 @@ use plotters::style::RGBColor;
 use serde::Serialize;
 use std::path::PathBuf;
 use sylva_core::Tree;
+use sylva_core::animate::seam_buffers;
 use sylva_core::animate::zioma::{Zioma, ZiomaParams};
-use sylva_core::mesh::{AKAGI_TABLE_2, MeshLayout, MeshParams, pose_buffers};
+use sylva_core::mesh::{AKAGI_TABLE_2, MeshLayout, MeshParams};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 
@@ -123,8 +124,8 @@ pub fn run(
         let layout = MeshLayout::concat(&members.iter().map(|m| &m.1).collect::<Vec<_>>())?;
         let (mut joint, mut acc) = (Vec::new(), Vec::new());
         for (t, _) in &members {
-            let pose = Zioma::new(t, ZiomaParams::default()).pose_packed(t, &fields, &waves, 2.0);
-            let (j, a) = pose_buffers(t, &pose);
+            let delta = Zioma::new(t, ZiomaParams::default()).rotations_packed(t, &fields, &waves, 2.0);
+            let (j, a) = seam_buffers(t, &delta);
             joint.extend(j);
             acc.extend(a);
         }

@@ -6,17 +6,18 @@
 use anyhow::{Context, Result, bail};
 use glam::{Mat4, Quat, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
+use std::borrow::Cow;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
-use sylva_core::animate::Pose;
 use sylva_core::animate::akagi::{Akagi, AkagiParams, AkagiState};
 use sylva_core::animate::hsm::{Hsm, HsmParams, HsmState};
 use sylva_core::animate::skjermo::{Skjermo, SkjermoParams, SkjermoState};
 use sylva_core::animate::zioma::{Zioma, ZiomaInstance, ZiomaParams};
-use sylva_core::mesh::{DeformLayout, DeformerParams, MeshLayout, MeshParams, SkinLayout, pose_buffers};
+use sylva_core::animate::{Pose, seam_buffers};
+use sylva_core::mesh::{DeformLayout, DeformerParams, MeshLayout, MeshParams, SkinLayout};
 use sylva_core::scene::{BackendChoice, MethodName, Scene};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
@@ -137,8 +138,8 @@ impl Anim {
         encoder: &mut wgpu::CommandEncoder,
     ) -> Result<()> {
         let (fields, waves) = wind;
-        let cpu_pose: Option<Pose> = match self {
-            Self::ZiomaCpu(m) => Some(m.pose_packed(tree, fields, waves, t)),
+        let cpu_pose: Option<Cow<'_, Pose>> = match self {
+            Self::ZiomaCpu(m) => Some(Cow::Owned(m.pose_packed(tree, fields, waves, t))),
             Self::ZiomaGpu(m, g) => {
                 g.submit(ctx, tree, m, t);
                 None
@@ -147,7 +148,7 @@ impl Anim {
                 for _ in 0..steps {
                     m.step(tree, fields, waves, s, dt);
                 }
-                Some(s.pose.clone())
+                Some(Cow::Borrowed(&s.pose))
             }
             Self::AkagiGpu(g) => {
                 for _ in 0..steps {
@@ -159,7 +160,7 @@ impl Anim {
                 for _ in 0..steps {
                     m.step(tree, fields, waves, s, dt);
                 }
-                Some(s.pose.clone())
+                Some(Cow::Borrowed(&s.pose))
             }
             Self::SkjermoGpu(g) => {
                 for _ in 0..steps {
@@ -171,7 +172,7 @@ impl Anim {
                 for _ in 0..steps {
                     m.step(fields, waves, s, dt);
                 }
-                Some(m.pose(tree, s))
+                Some(Cow::Owned(m.pose(tree, s)))
             }
             Self::HsmGpu(m, g) => {
                 g.advance(ctx, m, dt, steps);
@@ -262,12 +263,7 @@ impl ZiomaForest {
             }
             None => {
                 let delta = self.method.rotations_instances(tree, wind.0, wind.1, t, &self.instances);
-                let (mut joint, mut acc) = (Vec::new(), Vec::new());
-                for pose in Pose::from_rotations_instances(tree, &delta) {
-                    let (j, a) = pose_buffers(tree, &pose);
-                    joint.extend(j);
-                    acc.extend(a);
-                }
+                let (joint, acc) = seam_buffers(tree, &delta);
                 ctx.queue.write_buffer(&self.joint, 0, bytemuck::cast_slice(&joint));
                 ctx.queue.write_buffer(&self.acc, 0, bytemuck::cast_slice(&acc));
                 self.skin.record(ctx, encoder, &self.joint, &self.acc);

@@ -233,12 +233,7 @@ fn zioma_instances_table(ctx: Option<&'static GpuContext>, wind: &WindScene) {
         let cpu_skin = time(5, || {
             tt += 1.0 / 60.0;
             let d = z.rotations_instances(&t, &fields, &waves, tt, &instances);
-            let (mut joint, mut acc) = (Vec::new(), Vec::new());
-            for p in sylva_core::animate::Pose::from_rotations_instances(&t, &d) {
-                let (j, a) = sylva_core::mesh::pose_buffers(&t, &p);
-                joint.extend(j);
-                acc.extend(a);
-            }
+            let (joint, acc) = sylva_core::animate::seam_buffers(&t, &d);
             std::hint::black_box(skin.skin(&joint, &acc, count as u32));
         });
         let gpu = ctx.map(|c| {

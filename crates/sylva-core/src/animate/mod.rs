@@ -80,34 +80,38 @@ impl Pose {
     /// Poses of many instances of one tree from their rotations, instance-major
     /// (`instance × segments + segment`), in one parallel forward-kinematics pass.
     pub fn from_rotations_instances(tree: &Tree, delta: &[[f32; 4]]) -> Vec<Self> {
-        let n = tree.segments.len();
-        let mut acc = vec![[0.0f32; 4]; delta.len()];
-        crate::cpu::pose_fk::pose_accumulate(&tree.segments.parent, delta, &mut acc);
-        let mut out = vec![[0.0f32; 4]; delta.len()];
-        let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
-        crate::cpu::pose_fk::pose_positions(&tree.segments.parent, &rest, &acc, &mut out);
-        out.chunks(n.max(1))
-            .zip(acc.chunks(n.max(1)))
-            .map(|(j, a)| Self {
-                start: j.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect(),
-                orientation: a.iter().zip(&tree.segments.orientation).map(|(d, q)| Quat::from_array(*d) * *q).collect(),
-                bezier: None,
-            })
-            .collect()
+        let n = tree.segments.len().max(1);
+        let (joints, acc) = seam_buffers(tree, delta);
+        joints.chunks(n).zip(acc.chunks(n)).map(|(j, a)| Self::from_seam(tree, j, a)).collect()
     }
 
     /// Pose from per-segment rotations `δ` (x, y, z, w), by forward kinematics.
     pub fn from_rotations(tree: &Tree, delta: &[[f32; 4]]) -> Self {
-        let n = tree.segments.len();
-        let mut acc = vec![[0.0f32; 4]; n];
-        crate::cpu::pose_fk::pose_accumulate(&tree.segments.parent, delta, &mut acc);
-        let mut out = vec![[0.0f32; 4]; n];
-        let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
-        crate::cpu::pose_fk::pose_positions(&tree.segments.parent, &rest, &acc, &mut out);
-        let start = out.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
-        let orientation = acc.iter().zip(&tree.segments.orientation).map(|(d, q)| Quat::from_array(*d) * *q).collect();
-        Self { start, orientation, bezier: None }
+        let (joints, acc) = seam_buffers(tree, delta);
+        Self::from_seam(tree, &joints, &acc)
     }
+
+    /// Pose from the seam's buffers of one instance: joints (w ignored) and accumulated
+    /// rotations `D` (orientation `D · Q_rest`).
+    pub fn from_seam(tree: &Tree, joints: &[[f32; 4]], acc: &[[f32; 4]]) -> Self {
+        Self {
+            start: joints.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect(),
+            orientation: acc.iter().zip(&tree.segments.orientation).map(|(d, q)| Quat::from_array(*d) * *q).collect(),
+            bezier: None,
+        }
+    }
+}
+
+/// The pose seam's buffers from rotations `δ`, instance-major: joint positions (w = 0) and
+/// accumulated rotations `D`, by forward kinematics (ancestor walks, rayon). What meshers and
+/// skinning read; [`Pose`] is the same data with world orientations.
+pub fn seam_buffers(tree: &Tree, delta: &[[f32; 4]]) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    let mut acc = vec![[0.0f32; 4]; delta.len()];
+    crate::cpu::pose_fk::pose_accumulate(&tree.segments.parent, delta, &mut acc);
+    let mut joints = vec![[0.0f32; 4]; delta.len()];
+    let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
+    crate::cpu::pose_fk::pose_positions(&tree.segments.parent, &rest, &acc, &mut joints);
+    (joints, acc)
 }
 
 /// Mechanical radius of each segment, m: its own base radius, but never thinner than
