@@ -4,6 +4,7 @@
 
 mod bench_akagi;
 mod bench_cmd;
+mod export_cmd;
 mod render_cmd;
 mod simulate_cmd;
 mod wind_cmd;
@@ -39,6 +40,9 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Reproduce a paper's result table on the CPU and the GPU, with plots.
     Bench(bench_cmd::BenchArgs),
+    /// Export a tree as glTF 2.0 (.glb/.gltf): mesh, materials, a skin and wind baked from
+    /// any method (optionally looping), hierarchy attributes for engine wind shaders, LODs.
+    Export(export_cmd::ExportArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -80,6 +84,7 @@ fn main() -> Result<()> {
             Ok(())
         }
         Some(Command::Simulate(args)) => simulate_cmd::run(&args),
+        Some(Command::Export(args)) => export_cmd::run(&args).map(|_| ()),
         Some(Command::Bench(args)) => {
             for p in bench_cmd::run(&args)? {
                 println!("wrote {}", p.display());

@@ -385,3 +385,76 @@ fn bench_quick_writes_complete_tables() {
     let (ok, _, err) = sylva(dir.path(), &["bench", "song-t2", "--budget", "0"]);
     assert!(!ok && err.contains("--budget"), "{err}");
 }
+
+#[test]
+fn export_writes_a_looping_glb_and_reports_every_lod() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = sylva(
+        dir.path(),
+        &[
+            "export",
+            "--species",
+            "palm",
+            "--method",
+            "akagi",
+            "--seconds",
+            "1",
+            "--fps",
+            "20",
+            "--loop",
+            "--blend",
+            "0.25",
+            "--out",
+            "palm.glb",
+        ],
+    );
+    assert!(ok, "{out}\n{err}");
+    let bytes = std::fs::read(dir.path().join("palm.glb")).unwrap();
+    assert_eq!(&bytes[..4], b"glTF");
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize, bytes.len(), "GLB length field");
+    for lod in ["  0 ", "  1 ", "  2 "] {
+        assert!(out.lines().any(|l| l.starts_with(lod)), "LOD row `{lod}` missing:\n{out}");
+    }
+    assert!(out.contains("21 keys") && out.contains("looping") && out.contains("309 joints"), "{out}");
+    // Static .gltf: one JSON file, no skin.
+    let (ok, out, err) = sylva(dir.path(), &["export", "--species", "palm", "--static", "--out", "palm.gltf"]);
+    assert!(ok, "{out}\n{err}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("palm.gltf")).unwrap()).unwrap();
+    assert!(json.get("skins").is_none() && json.get("animations").is_none());
+    assert!(json["buffers"][0]["uri"].as_str().unwrap().starts_with("data:application/octet-stream;base64,"));
+}
+
+#[test]
+fn export_rejects_bad_input_and_leaves_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["--fps", "0"], "`fps` = 0"),
+        (&["--seconds", "-2"], "`seconds` = -2"),
+        (&["--max-joints", "10"], "more than the limit of 10"),
+        (&["--joints", "stem", "--max-joints", "10"], "joints (one per stem)"),
+        (&["--lod", "8,3,8"], "four values"),
+        (&["--lod", "2,3,8,1"], "`sides` = 2"),
+        (&["--out", "tree.fbx"], ".glb or .gltf"),
+        (&["--out", "/proc/sylva/tree.glb"], "/proc/sylva"),
+        (&["--loop", "--seconds", "1", "--blend", "0.9"], "`blend` = 0.9"),
+    ];
+    for (args, expect) in cases {
+        let mut all = vec!["export", "--species", "palm"];
+        all.extend_from_slice(args);
+        for (flag, value) in [("--seconds", "0.5"), ("--fps", "10")] {
+            if !args.contains(&flag) {
+                all.extend_from_slice(&[flag, value]);
+            }
+        }
+        if !args.contains(&"--out") {
+            all.extend_from_slice(&["--out", "tree.glb"]);
+        }
+        let (ok, out, err) = sylva(dir.path(), &all);
+        assert!(!ok, "{args:?} should fail:\n{out}");
+        assert!(err.contains(expect), "{args:?}: expected `{expect}` in:\n{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "files left behind: {left:?}");
+}

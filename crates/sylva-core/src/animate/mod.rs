@@ -20,10 +20,13 @@
 //! position and orientation, plus animated Bézier control points for methods that have them.
 
 pub mod akagi;
+pub mod driver;
 pub mod hsm;
 pub mod skjermo;
 pub mod skjermo_lanes;
 pub mod zioma;
+
+pub use driver::CpuAnimator;
 
 use crate::model::Tree;
 use glam::{Quat, Vec3};

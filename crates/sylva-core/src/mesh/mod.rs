@@ -327,6 +327,42 @@ impl MeshLayout {
         Ok(out)
     }
 
+    /// Keeps about `keep` (0…1] of the leaves — each leaf by a hash of its index and
+    /// `seed`, so the choice is stable — and scales the kept blades by `1 / √keep` in width
+    /// and length, so the crown's leaf area (its look from afar) stays the same. For
+    /// level-of-detail meshes.
+    pub fn thin_leaves(&mut self, keep: f32, seed: u64) -> Result<(), MeshError> {
+        if !(keep.is_finite() && keep > 0.0 && keep <= 1.0) {
+            return Err(MeshError::Param {
+                field: "leaf_keep",
+                value: keep.to_string(),
+                expected: "more than 0, at most 1",
+            });
+        }
+        if keep == 1.0 {
+            return Ok(());
+        }
+        let grow = 1.0 / keep.sqrt();
+        let key = crate::rng::mix64(seed ^ 0x1eaf);
+        let mut index = 0u64;
+        self.leaves.retain(|_| {
+            index += 1;
+            (crate::rng::hash_unit(crate::rng::child_key(key, index)) as f32) < keep
+        });
+        for l in &mut self.leaves {
+            l.width *= grow;
+            l.length *= grow;
+        }
+        let stride = self.params.leaf_sides + 1;
+        let sides = self.params.leaf_sides;
+        self.leaf_indices = (0..self.leaves.len() as u32)
+            .flat_map(|l| {
+                (0..sides).flat_map(move |j| [l * stride, l * stride + 1 + j, l * stride + 1 + (j + 1) % sides])
+            })
+            .collect();
+        Ok(())
+    }
+
     /// Frame constants for the kernels.
     pub fn info(&self) -> RawMeshInfo {
         RawMeshInfo {

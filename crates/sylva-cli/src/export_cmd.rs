@@ -1,0 +1,222 @@
+//! `sylva export`: a tree as glTF 2.0 (`.glb` or `.gltf`) with a skin and wind baked from
+//! any method, hierarchy attributes for engine-side wind, and levels of detail.
+
+use crate::simulate_cmd::Method;
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+use std::time::Instant;
+use sylva_core::export::{BakeParams, DEFAULT_LODS, GltfOptions, JointMode, Lod, bake, write_gltf};
+use sylva_core::scene::MethodName;
+use sylva_core::species::{DEFAULT_SPECIES, SpeciesSource};
+use sylva_core::wind::WindScene;
+use sylva_core::{Limits, Tree};
+
+/// Joints of the skin.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Joints {
+    /// One joint per segment: the full motion.
+    Segment,
+    /// One joint per stem (for engines with a bone limit): each stem moves rigidly about
+    /// its base.
+    Stem,
+}
+
+/// Arguments of `sylva export`.
+#[derive(clap::Args, Debug)]
+pub struct ExportArgs {
+    /// A preset name, a Weber–Penn TOML file or an L-system grammar file.
+    #[arg(long, short, default_value = DEFAULT_SPECIES)]
+    pub species: String,
+    /// Random seed of the tree (and of Zioma's branch phases).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Animation method baked into the clip.
+    #[arg(long, value_enum, default_value = "zioma")]
+    pub method: Method,
+    /// A wind preset (`gusty`, `blast`) or a scene TOML file.
+    #[arg(long, default_value = "gusty")]
+    pub wind: String,
+    /// Clip length, s.
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    pub seconds: f32,
+    /// Frames (animation keys) per second.
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    pub fps: f32,
+    /// Make the clip loop seamlessly: the ends are cross-faded over `--blend` seconds.
+    #[arg(long = "loop", default_value_t = false)]
+    pub looped: bool,
+    /// Cross-fade window of a looping clip, s.
+    #[arg(long, default_value_t = BakeParams::default().blend, allow_negative_numbers = true)]
+    pub blend: f32,
+    /// Simulated time before the clip starts, s (stateful methods settle into the wind).
+    #[arg(long, default_value_t = BakeParams::default().preroll, allow_negative_numbers = true)]
+    pub preroll: f32,
+    /// Simulation steps per second of stateful methods.
+    #[arg(long, default_value_t = BakeParams::default().sim_rate)]
+    pub sim_rate: f32,
+    /// Static export: the mesh and hierarchy attributes, no skin, no animation.
+    #[arg(long = "static", default_value_t = false)]
+    pub static_only: bool,
+    /// Joints of the skin.
+    #[arg(long, value_enum, default_value = "segment")]
+    pub joints: Joints,
+    /// Refuse to write a skin with more joints than this (your engine's bone limit).
+    #[arg(long)]
+    pub max_joints: Option<usize>,
+    /// A level of detail as `sides,samples,leaf_sides,leaf_keep` (repeat for several,
+    /// finest first). Default: 8,3,8,1 6,2,6,0.5 4,1,4,0.25.
+    #[arg(long = "lod", value_parser = parse_lod)]
+    pub lods: Vec<Lod>,
+    /// Output file: `.glb` (binary) or `.gltf` (JSON, buffers embedded). Default:
+    /// out/<species>.glb.
+    #[arg(long, short)]
+    pub out: Option<PathBuf>,
+}
+
+fn parse_lod(s: &str) -> Result<Lod, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 4 {
+        return Err(format!("`{s}`: expected four values `sides,samples,leaf_sides,leaf_keep`, e.g. 6,2,6,0.5"));
+    }
+    let int = |i: usize, name: &str| {
+        parts[i].parse::<u32>().map_err(|_| format!("`{s}`: {name} `{}` is not a whole number", parts[i]))
+    };
+    Ok(Lod {
+        sides: int(0, "sides")?,
+        samples: int(1, "samples")?,
+        leaf_sides: int(2, "leaf_sides")?,
+        leaf_keep: parts[3].parse::<f32>().map_err(|_| format!("`{s}`: leaf_keep `{}` is not a number", parts[3]))?,
+    })
+}
+
+impl Method {
+    /// The core's name for the method.
+    pub fn name(self) -> MethodName {
+        match self {
+            Method::Zioma => MethodName::Zioma,
+            Method::Akagi => MethodName::Akagi,
+            Method::Skjermo => MethodName::Skjermo,
+            Method::Hsm => MethodName::Hsm,
+        }
+    }
+}
+
+/// Runs the command; returns the file written.
+pub fn run(a: &ExportArgs) -> Result<PathBuf> {
+    let out = a.out.clone().unwrap_or_else(|| {
+        let stem = std::path::Path::new(&a.species)
+            .file_stem()
+            .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from("out").join(format!("{stem}.glb"))
+    });
+    let params = BakeParams {
+        method: a.method.name(),
+        seed: a.seed,
+        seconds: a.seconds,
+        fps: a.fps,
+        looped: a.looped,
+        blend: a.blend,
+        preroll: a.preroll,
+        sim_rate: a.sim_rate,
+    };
+    let opts = GltfOptions {
+        joints: match a.joints {
+            Joints::Segment => JointMode::Segment,
+            Joints::Stem => JointMode::Stem,
+        },
+        max_joints: a.max_joints,
+        lods: if a.lods.is_empty() { DEFAULT_LODS.to_vec() } else { a.lods.clone() },
+    };
+    let tree = SpeciesSource::resolve(&a.species)?.generate(a.seed, &Limits::default(), None)?;
+    let wind = WindScene::resolve(&a.wind)?;
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    export(&tree, &wind, &params, &opts, a.static_only, &out)?;
+    Ok(out)
+}
+
+/// Bakes (unless static) and writes, printing what was written and how long it took.
+pub fn export(
+    tree: &Tree,
+    wind: &WindScene,
+    params: &BakeParams,
+    opts: &GltfOptions,
+    static_only: bool,
+    out: &std::path::Path,
+) -> Result<()> {
+    let t0 = Instant::now();
+    let clip = if static_only {
+        None
+    } else {
+        let bar = ProgressBar::new(0);
+        bar.set_style(
+            ProgressStyle::with_template("baking {msg} {bar:40} {pos}/{len} frames, {eta} left")
+                .expect("static template"),
+        );
+        bar.set_message(params.method.as_str());
+        let clip = bake(tree, wind, params, &mut |done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        })
+        .context("baking the animation")?;
+        bar.finish_and_clear();
+        Some(clip)
+    };
+    let baked = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let report = write_gltf(tree, clip.as_ref(), opts, out)?;
+    let written = t1.elapsed().as_secs_f64();
+    let size = std::fs::metadata(out).map(|m| m.len()).unwrap_or(0);
+    println!(
+        "{} (seed {}): {} segments, {} stems, {} leaves",
+        tree.name,
+        tree.seed,
+        tree.segments.len(),
+        tree.stems.len(),
+        tree.leaves.len()
+    );
+    println!(
+        "  {:<5} {:>5} {:>7} {:>10} {:>10} {:>9} {:>10} {:>10}",
+        "lod", "sides", "samples", "leaf sides", "leaf keep", "leaves", "triangles", "MiB"
+    );
+    for (k, l) in report.lods.iter().enumerate() {
+        println!(
+            "  {:<5} {:>5} {:>7} {:>10} {:>10} {:>9} {:>10} {:>10.2}",
+            k,
+            l.lod.sides,
+            l.lod.samples,
+            l.lod.leaf_sides,
+            l.lod.leaf_keep,
+            l.leaves,
+            l.triangles,
+            l.bytes as f64 / (1 << 20) as f64
+        );
+    }
+    if let Some(c) = &clip {
+        println!(
+            "  skin: {} joints; animation `wind`: {} keys ({:.2} s at {} fps{}), {} channels, {:.2} MiB",
+            report.joints,
+            report.frames,
+            c.duration(),
+            c.fps,
+            if c.looped { ", looping" } else { "" },
+            report.channels,
+            report.animation_bytes as f64 / (1 << 20) as f64
+        );
+    } else {
+        println!("  static: no skin, no animation");
+    }
+    println!("  textures {:.2} MiB", report.texture_bytes as f64 / (1 << 20) as f64);
+    if static_only {
+        println!("  wrote in {written:.2} s");
+    } else {
+        println!("  baked in {baked:.2} s, wrote in {written:.2} s");
+    }
+    println!("wrote {} ({:.2} MiB)", out.display(), size as f64 / (1 << 20) as f64);
+    if size == 0 {
+        bail!("{}: the file is empty", out.display());
+    }
+    Ok(())
+}

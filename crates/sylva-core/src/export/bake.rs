@@ -1,0 +1,269 @@
+//! Baking: any animation method run on the CPU and sampled at a fixed frame rate into a
+//! [`Clip`] — per frame the pose seam's buffers (joint positions and accumulated
+//! rotations `D` per segment), which skinning and the glTF exporter consume.
+//!
+//! # Looping clips
+//!
+//! The wind is not periodic, and stateful methods never return exactly to an earlier
+//! state, so a loop is made by **cross-fading the ends**: the method runs for `T + B`
+//! seconds (`T` the clip, `B` the blend window) and frame `t` of the clip is
+//!
+//! * `p(t)` for `B ≤ t ≤ T`,
+//! * `blend(p(t + T), p(t), w(t / B))` for `0 ≤ t < B`, with `w(x) = 3x² − 2x³`.
+//!
+//! So the clip starts at `p(T)`, exactly where it ends, and because `w′(0) = 0` its velocity
+//! at the start is `p′(T)`, the velocity at its end: no jump in pose or speed across the
+//! seam. Blending is done on each segment's *local* transform (rotation and offset relative
+//! to its parent: slerp and lerp), and the pose is rebuilt root to tip, so the skeleton
+//! stays connected while blending. The last frame is a copy of the first (glTF clips play
+//! from the first key to the last).
+
+use crate::animate::{CpuAnimator, hsm::HsmError};
+use crate::mesh::quat_slerp;
+use crate::model::{NONE, Tree};
+use crate::scene::MethodName;
+use crate::wind::WindScene;
+use glam::{Quat, Vec3};
+
+/// Largest `frames × segments` a clip may hold (32 bytes each: 512 MiB).
+pub const MAX_CLIP_VALUES: u64 = 16 << 20;
+
+/// How to bake.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BakeParams {
+    /// Animation method.
+    pub method: MethodName,
+    /// Seed of the method's own randomness (Zioma's branch phases).
+    pub seed: u64,
+    /// Clip length, s.
+    pub seconds: f32,
+    /// Frames per second of the clip.
+    pub fps: f32,
+    /// Make the clip loop seamlessly (see the module documentation).
+    pub looped: bool,
+    /// Cross-fade window of a looping clip, s. Default 1 s: long against a frame, short
+    /// against the clip, and about one period of a branch's sway.
+    pub blend: f32,
+    /// Simulated time before the clip starts, s. Default 2 s, so stateful methods have left
+    /// their rest pose and settled into the wind before frame 0.
+    pub preroll: f32,
+    /// Simulation steps per second of stateful methods. Default 120 Hz: every method is
+    /// stable there, and it is a whole multiple of 24, 30 and 60 fps.
+    pub sim_rate: f32,
+}
+
+impl Default for BakeParams {
+    fn default() -> Self {
+        Self {
+            method: MethodName::Zioma,
+            seed: 1,
+            seconds: 10.0,
+            fps: 30.0,
+            looped: false,
+            blend: 1.0,
+            preroll: 2.0,
+            sim_rate: 120.0,
+        }
+    }
+}
+
+/// Errors baking a clip.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BakeError {
+    /// A parameter is out of range.
+    #[error("bake parameter `{field}` = {value}: expected {expected}")]
+    Param { field: &'static str, value: String, expected: String },
+    /// The clip would be too large.
+    #[error(
+        "the clip would hold {frames} frames × {segments} segments; the limit is {limit} (shorten it, lower the fps or use a smaller tree)"
+    )]
+    TooLarge { frames: u64, segments: u64, limit: u64 },
+    /// The method could not be built.
+    #[error(transparent)]
+    Method(#[from] HsmError),
+}
+
+/// A baked animation: the pose seam's buffers per frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Clip {
+    /// Frames per second.
+    pub fps: f32,
+    /// The last frame equals the first and the clip plays seamlessly in a loop.
+    pub looped: bool,
+    /// Joint position of every segment (w = 0), per frame.
+    pub joints: Vec<Vec<[f32; 4]>>,
+    /// Accumulated rotation `D` of every segment, per frame.
+    pub acc: Vec<Vec<[f32; 4]>>,
+}
+
+impl Clip {
+    /// Number of frames (keys), the first at t = 0 and the last at [`Clip::duration`].
+    pub fn frames(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// Clip length, s.
+    pub fn duration(&self) -> f32 {
+        (self.frames().saturating_sub(1)) as f32 / self.fps
+    }
+}
+
+impl BakeParams {
+    /// Checks every field; returns (clip frames N, blend frames, steps per frame).
+    fn check(&self, segments: usize) -> Result<(usize, usize, usize), BakeError> {
+        let bad = |field, value: f32, expected: &str| {
+            Err(BakeError::Param { field, value: value.to_string(), expected: expected.to_string() })
+        };
+        if !(self.fps.is_finite() && self.fps > 0.0 && self.fps <= 240.0) {
+            return bad("fps", self.fps, "more than 0 and at most 240 frames per second");
+        }
+        if !(self.seconds.is_finite() && self.seconds > 0.0 && self.seconds <= 3600.0) {
+            return bad("seconds", self.seconds, "more than 0 and at most 3600 seconds");
+        }
+        let n = (self.seconds * self.fps).round() as usize;
+        if n < 1 {
+            return bad("seconds", self.seconds, "at least one frame interval (1 / fps)");
+        }
+        if !(self.preroll.is_finite() && (0.0..=600.0).contains(&self.preroll)) {
+            return bad("preroll", self.preroll, "0 to 600 seconds");
+        }
+        if !(self.sim_rate.is_finite() && self.sim_rate >= self.fps && self.sim_rate <= 2000.0) {
+            return bad("sim_rate", self.sim_rate, "at least fps and at most 2000 steps per second");
+        }
+        let blend_frames = if self.looped {
+            if !(self.blend.is_finite() && self.blend >= 0.0) {
+                return bad("blend", self.blend, "a non-negative number of seconds");
+            }
+            let b = (self.blend * self.fps).round() as usize;
+            if b < 2 || b > n / 2 {
+                return Err(BakeError::Param {
+                    field: "blend",
+                    value: self.blend.to_string(),
+                    expected: format!(
+                        "a loop's cross-fade of at least 2 frames and at most half the clip: {} to {} s at {} fps",
+                        2.0 / self.fps,
+                        (n / 2) as f32 / self.fps,
+                        self.fps
+                    ),
+                });
+            }
+            b
+        } else {
+            0
+        };
+        let frames = (n + 1 + blend_frames) as u64;
+        if frames * segments as u64 > MAX_CLIP_VALUES {
+            return Err(BakeError::TooLarge { frames, segments: segments as u64, limit: MAX_CLIP_VALUES });
+        }
+        let steps = (self.sim_rate / self.fps).ceil().max(1.0) as usize;
+        Ok((n, blend_frames, steps))
+    }
+}
+
+/// Bakes `params.method` on `tree` in `wind`. `progress(done, total)` is called after each
+/// simulated frame.
+pub fn bake(
+    tree: &Tree,
+    wind: &WindScene,
+    params: &BakeParams,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Clip, BakeError> {
+    let (n, blend, steps) = params.check(tree.segments.len())?;
+    let mut anim = CpuAnimator::new(tree, params.method, params.seed)?;
+    let (fields, waves) = wind.pack();
+    let dt = 1.0 / (params.fps * steps as f32);
+    // Preroll: whole frames of simulated time before frame 0.
+    let pre_frames = (params.preroll * params.fps).round() as usize;
+    if anim.is_stateful() {
+        for _ in 0..pre_frames {
+            anim.advance(tree, &fields, &waves, 0.0, dt, steps);
+        }
+    }
+    let t0 = pre_frames as f32 / params.fps;
+    let total = n + 1 + blend;
+    let mut joints = Vec::with_capacity(total);
+    let mut acc = Vec::with_capacity(total);
+    for k in 0..total {
+        let (j, a) =
+            anim.advance(tree, &fields, &waves, t0 + k as f32 / params.fps, dt, if k == 0 { 0 } else { steps });
+        joints.push(j);
+        acc.push(a);
+        progress(k + 1, total);
+    }
+    if params.looped {
+        let mut out_j = Vec::with_capacity(n + 1);
+        let mut out_a = Vec::with_capacity(n + 1);
+        for k in 0..n {
+            if k < blend {
+                let x = k as f32 / blend as f32;
+                let w = x * x * (3.0 - 2.0 * x);
+                let (j, a) = blend_poses(tree, (&joints[k + n], &acc[k + n]), (&joints[k], &acc[k]), w);
+                out_j.push(j);
+                out_a.push(a);
+            } else {
+                out_j.push(std::mem::take(&mut joints[k]));
+                out_a.push(std::mem::take(&mut acc[k]));
+            }
+        }
+        out_j.push(out_j[0].clone());
+        out_a.push(out_a[0].clone());
+        joints = out_j;
+        acc = out_a;
+    }
+    Ok(Clip { fps: params.fps, looped: params.looped, joints, acc })
+}
+
+/// Each segment's transform relative to its parent's: rotation `D_p⁻¹ D` and offset
+/// `D_p⁻¹ (j − j_p)` (the root's relative to the world).
+pub fn local_transforms(tree: &Tree, joints: &[[f32; 4]], acc: &[[f32; 4]]) -> (Vec<Quat>, Vec<Vec3>) {
+    let s = &tree.segments;
+    (0..s.len())
+        .map(|i| {
+            let d = Quat::from_array(acc[i]);
+            let j = Vec3::from_slice(&joints[i][..3]);
+            match s.parent[i] {
+                NONE => (d, j),
+                p => {
+                    let dp_inv = Quat::from_array(acc[p as usize]).conjugate();
+                    ((dp_inv * d).normalize(), dp_inv * (j - Vec3::from_slice(&joints[p as usize][..3])))
+                }
+            }
+        })
+        .unzip()
+}
+
+/// Rebuilds joints and accumulated rotations from local transforms, root to tip (segments
+/// are in topological order).
+pub fn from_local_transforms(tree: &Tree, rot: &[Quat], offset: &[Vec3]) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    let s = &tree.segments;
+    let mut d = vec![Quat::IDENTITY; s.len()];
+    let mut j = vec![Vec3::ZERO; s.len()];
+    for i in 0..s.len() {
+        match s.parent[i] {
+            NONE => {
+                d[i] = rot[i];
+                j[i] = offset[i];
+            }
+            p => {
+                let p = p as usize;
+                d[i] = (d[p] * rot[i]).normalize();
+                j[i] = j[p] + d[p] * offset[i];
+            }
+        }
+    }
+    (j.iter().map(|p| p.extend(0.0).to_array()).collect(), d.iter().map(|q| q.to_array()).collect())
+}
+
+/// `a` blended toward `b` by `w` (0 = a, 1 = b), per segment in local terms.
+fn blend_poses(
+    tree: &Tree,
+    a: (&[[f32; 4]], &[[f32; 4]]),
+    b: (&[[f32; 4]], &[[f32; 4]]),
+    w: f32,
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    let (ra, oa) = local_transforms(tree, a.0, a.1);
+    let (rb, ob) = local_transforms(tree, b.0, b.1);
+    let rot: Vec<Quat> = ra.iter().zip(&rb).map(|(x, y)| quat_slerp(*x, *y, w)).collect();
+    let off: Vec<Vec3> = oa.iter().zip(&ob).map(|(x, y)| x.lerp(*y, w)).collect();
+    from_local_transforms(tree, &rot, &off)
+}

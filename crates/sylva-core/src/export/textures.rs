@@ -1,0 +1,140 @@
+//! Procedural textures shipped inside exported files: a tileable bark colour map and a
+//! leaf colour map whose alpha cuts the blade's outline. Deterministic (the same bytes
+//! every run), so exported files are reproducible.
+//!
+//! Coordinates follow the meshes: bark `u` runs once around the stem and `v` along it (both
+//! repeat); a leaf's `u` runs across the blade (0.5 the midrib) and `v` from the base
+//! (image row 0) to the tip (the last row).
+
+use crate::cpu::noise::hash_unit;
+use std::f32::consts::{PI, TAU};
+
+/// Side of each texture, pixels.
+pub const TEXTURE_SIZE: u32 = 256;
+
+/// Value noise on a `period × period` lattice that wraps, so the texture tiles.
+fn tiled_noise(x: f32, y: f32, period: u32, seed: u32) -> f32 {
+    let (fx, fy) = (x * period as f32, y * period as f32);
+    let (ix, iy) = (fx.floor(), fy.floor());
+    let (tx, ty) = (fx - ix, fy - iy);
+    let (sx, sy) = (tx * tx * (3.0 - 2.0 * tx), ty * ty * (3.0 - 2.0 * ty));
+    let at = |i: f32, j: f32| {
+        let i = (i as i64).rem_euclid(period as i64) as u32;
+        let j = (j as i64).rem_euclid(period as i64) as u32;
+        hash_unit(i.wrapping_mul(73_856_093) ^ j.wrapping_mul(19_349_663) ^ seed)
+    };
+    let a = at(ix, iy) + (at(ix + 1.0, iy) - at(ix, iy)) * sx;
+    let b = at(ix, iy + 1.0) + (at(ix + 1.0, iy + 1.0) - at(ix, iy + 1.0)) * sx;
+    a + (b - a) * sy
+}
+
+fn encode_png(pixels: &[u8], color: image::ExtendedColorType) -> Vec<u8> {
+    use image::ImageEncoder;
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(pixels, TEXTURE_SIZE, TEXTURE_SIZE, color)
+        .expect("encoding a PNG into memory cannot fail");
+    out
+}
+
+/// Bark ridges (0…1) and fine grain (0…1) at (u, v): seven ridges around the stem, as the
+/// mesh's relief, wandering with height.
+fn bark_height(u: f32, v: f32) -> (f32, f32) {
+    let wander = tiled_noise(u, v, 4, 11) - 0.5;
+    let ridge = (TAU * (7.0 * u + 0.6 * wander)).sin().abs().powf(0.6);
+    let grain = tiled_noise(u, v, 32, 23) * 0.5 + tiled_noise(u, v, 64, 37) * 0.5;
+    (ridge, grain)
+}
+
+/// A tangent-space normal map (RGB PNG) of the height field `h` (in texels of relief per
+/// texel), by central differences that wrap: +x along `u`, +y along `v`, +z out.
+fn normal_map(h: impl Fn(f32, f32) -> f32, strength: f32) -> Vec<u8> {
+    let n = TEXTURE_SIZE;
+    let d = 1.0 / n as f32;
+    let mut px = Vec::with_capacity((n * n * 3) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let (u, v) = (x as f32 * d, y as f32 * d);
+            let du = (h((u + d) % 1.0, v) - h((u - d + 1.0) % 1.0, v)) * 0.5 * strength;
+            let dv = (h(u, (v + d) % 1.0) - h(u, (v - d + 1.0) % 1.0)) * 0.5 * strength;
+            let nrm = glam::Vec3::new(-du, -dv, 1.0).normalize();
+            px.extend(nrm.to_array().iter().map(|c| ((c * 0.5 + 0.5) * 255.0).round() as u8));
+        }
+    }
+    encode_png(&px, image::ExtendedColorType::Rgb8)
+}
+
+/// Bark normal map: the relief of [`bark_png`]'s ridges and grain.
+pub fn bark_normal_png() -> Vec<u8> {
+    normal_map(
+        |u, v| {
+            let (ridge, grain) = bark_height(u, v);
+            ridge + 0.15 * grain
+        },
+        12.0,
+    )
+}
+
+/// Leaf normal map: the midrib and veins raised.
+pub fn leaf_normal_png() -> Vec<u8> {
+    normal_map(|u, v| leaf_veins(u, v).0, 12.0)
+}
+
+/// Midrib + veins (0…1) and the blade's coverage (0…1) at (u, v).
+fn leaf_veins(u: f32, v: f32) -> (f32, f32) {
+    let n = TEXTURE_SIZE as f32;
+    let across = (u - 0.5).abs();
+    let half = leaf_half_width(v);
+    let edge = ((half - across) * n + 0.5).clamp(0.0, 1.0);
+    let midrib = (1.0 - across * n / 2.5).max(0.0);
+    // Veins leave the midrib toward the tip at about 45°.
+    let s = (v - across * 0.9) * 9.0;
+    let f = s - s.floor();
+    let vein = (1.0 - f.min(1.0 - f) * 14.0).clamp(0.0, 1.0) * 0.5;
+    ((midrib * 0.6 + vein * (1.0 - across / half.max(1e-3)).max(0.0)).min(1.0) * edge, edge)
+}
+
+/// Bark: grey-brown furrows running along the stem (seven ridges around it, as the mesh's
+/// relief), broken by noise; RGB PNG.
+pub fn bark_png() -> Vec<u8> {
+    let n = TEXTURE_SIZE;
+    let mut px = Vec::with_capacity((n * n * 3) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let (u, v) = (x as f32 / n as f32, y as f32 / n as f32);
+            let (ridge, grain) = bark_height(u, v);
+            let lum = 0.20 + 0.28 * ridge + 0.16 * grain;
+            let moss = (tiled_noise(u, v, 8, 51) - 0.62).max(0.0) * 0.6;
+            let rgb = [lum * 1.05 - moss * 0.2, lum * 0.92 + moss * 0.3, lum * 0.78 - moss * 0.1];
+            px.extend(rgb.iter().map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8));
+        }
+    }
+    encode_png(&px, image::ExtendedColorType::Rgb8)
+}
+
+/// Half-width of the leaf outline at `v` (0 base … 1 tip), in texture units: rounded at
+/// the base, pointed at the tip, never wider than the mesh's ellipse.
+pub fn leaf_half_width(v: f32) -> f32 {
+    if !(0.0..=1.0).contains(&v) {
+        return 0.0;
+    }
+    0.46 * (PI * v.powf(0.75)).sin().max(0.0).powf(0.9) * (1.0 - v).powf(0.15)
+}
+
+/// Leaf: green blade with a lighter midrib and veins, alpha 255 inside the outline and 0
+/// outside (a one-pixel soft edge); RGBA PNG.
+pub fn leaf_png() -> Vec<u8> {
+    let n = TEXTURE_SIZE;
+    let mut px = Vec::with_capacity((n * n * 4) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let (u, v) = ((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
+            let (light, edge) = leaf_veins(u, v);
+            let shade = 0.85 + 0.15 * tiled_noise(u, v, 16, 71);
+            let rgb = [(0.16 + 0.20 * light) * shade, (0.38 + 0.25 * light) * shade, (0.08 + 0.12 * light) * shade];
+            px.extend(rgb.iter().map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8));
+            px.push((edge * 255.0).round() as u8);
+        }
+    }
+    encode_png(&px, image::ExtendedColorType::Rgba8)
+}
