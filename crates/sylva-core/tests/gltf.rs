@@ -304,9 +304,10 @@ fn joints_per_stem_move_each_stem_rigidly_about_its_base() {
         let first = t.stems.first_segment[stem] as usize;
         let d = Quat::from_array(c.acc[k][first]);
         let j = Vec3::from_slice(&c.joints[k][first][..3]);
-        for v in r * stride..(r + 1) * stride {
-            let expect = j + d * (rb.positions[v] - t.segments.start[first]);
-            assert!(skinned[v].distance(expect) <= tol, "ring {r}: {} m off", skinned[v].distance(expect));
+        let ring_vertices = r * stride..(r + 1) * stride;
+        for (p, s) in rb.positions[ring_vertices.clone()].iter().zip(&skinned[ring_vertices]) {
+            let expect = j + d * (*p - t.segments.start[first]);
+            assert!(s.distance(expect) <= tol, "ring {r}: {} m off", s.distance(expect));
         }
     }
 }
