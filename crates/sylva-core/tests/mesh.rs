@@ -83,8 +83,16 @@ fn topology_counts_follow_the_layout() {
     let l = MeshLayout::new(&t, p).unwrap();
     let rings: usize = t.stems.segment_count.iter().map(|&n| n as usize * p.samples as usize + 1).sum();
     assert_eq!(l.rings.len(), rings);
-    assert_eq!(l.tube_vertex_count(), rings * (p.sides as usize + 1));
-    assert_eq!(l.tube_indices.len(), (rings - t.stems.len()) * p.sides as usize * 6);
+    // §2.3: a subdivided band has 4 × sides + 1 midpoints and four times the triangles.
+    let sides = p.sides as usize;
+    let split = l.details.len() / (4 * sides + 1);
+    assert_eq!(l.details.len(), split * (4 * sides + 1));
+    assert!(split > 0, "the trunk's long quads are subdivided");
+    assert_eq!(l.tube_vertex_count(), rings * (sides + 1) + l.details.len());
+    assert_eq!(l.tube_indices.len(), (rings - t.stems.len() - split) * sides * 6 + split * sides * 24);
+    let plain = MeshLayout::new(&t, MeshParams { subdivide_min_edge: f32::INFINITY, ..p }).unwrap();
+    assert!(plain.details.is_empty());
+    assert_eq!(plain.tube_indices.len(), (rings - t.stems.len()) * sides * 6);
     assert_eq!(l.leaf_indices.len(), t.leaves.len() * p.leaf_sides as usize * 3);
     assert!(l.tube_indices.iter().all(|&i| (i as usize) < l.tube_vertex_count()));
     assert!(l.leaf_indices.iter().all(|&i| (i as usize) < l.leaf_vertex_count()));
@@ -190,14 +198,20 @@ fn a_forest_layout_meshes_like_its_trees() {
     acc.extend(ab);
     let m = forest.mesh_raw(&joint, &acc);
     let (ma, mb) = (la.mesh(&a, &pa), lb.mesh(&b, &pb));
-    assert_eq!(m.tubes, [ma.tubes.clone(), mb.tubes.clone()].concat());
+    // Bark vertices: every tree's ring vertices, then every tree's midpoints (§2.3).
+    let stride = p.sides as usize + 1;
+    let (ra, rb) = (la.rings.len() * stride, lb.rings.len() * stride);
+    assert!(!la.details.is_empty(), "the palm's trunk is subdivided");
+    assert_eq!(m.tubes, [&ma.tubes[..ra], &mb.tubes[..rb], &ma.tubes[ra..], &mb.tubes[rb..]].concat());
     assert_eq!(m.leaves, [ma.leaves.clone(), mb.leaves.clone()].concat());
     assert_eq!(forest.triangle_count(), la.triangle_count() + lb.triangle_count());
-    let off = la.tube_vertex_count() as u32;
-    assert_eq!(
-        &forest.tube_indices[la.tube_indices.len()..],
-        &lb.tube_indices.iter().map(|i| i + off).collect::<Vec<_>>()[..]
-    );
+    // Every forest triangle is its tree's triangle, vertex for vertex.
+    let (fa, fb) = forest.tube_indices.split_at(la.tube_indices.len());
+    for (mine, theirs, own) in [(fa, &la.tube_indices, &ma.tubes), (fb, &lb.tube_indices, &mb.tubes)] {
+        for (i, j) in mine.iter().zip(theirs.iter()) {
+            assert_eq!(m.tubes[*i as usize], own[*j as usize]);
+        }
+    }
     let other = MeshLayout::new(&b, MeshParams { sides: 5, ..p }).unwrap();
     assert!(MeshLayout::concat(&[&la, &other]).is_err());
 }
@@ -383,4 +397,49 @@ mod deformer {
         // The tip keeps a ring: never below a tenth of the base radius.
         assert!((deform_radius(&s, 1.0, 0.0).0 - 0.05).abs() < 1e-6);
     }
+}
+
+#[test]
+fn subdivided_bands_are_crack_free_and_displaced_by_the_relief_at_their_midpoints() {
+    use std::collections::HashSet;
+    let t = tree("quaking_aspen");
+    let l = MeshLayout::new(&t, MeshParams::default()).unwrap();
+    let m = l.mesh(&t, &random_pose(&t, 11, 0.1));
+    let stride = l.params.sides as usize + 1;
+    let base = l.rings.len() * stride;
+    assert!(!l.details.is_empty());
+    // Edges of triangles made of ring vertices only (bands not subdivided).
+    let plain: HashSet<(u32, u32)> = l
+        .tube_indices
+        .chunks(3)
+        .filter(|t| t.iter().all(|&i| (i as usize) < base))
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .map(|(a, b)| (a.min(b), a.max(b)))
+        .collect();
+    let (mut displaced, mut on_boundary) = (0, 0);
+    let mut largest = 0.0f32;
+    for (k, d) in l.details.iter().enumerate() {
+        let (a, b, v) = (&m.tubes[d.a as usize], &m.tubes[d.b as usize], &m.tubes[base + k]);
+        let mid = (pos(a) + pos(b)) * 0.5;
+        let off = pos(v) - mid;
+        if plain.contains(&(d.a.min(d.b), d.a.max(d.b))) {
+            // A midpoint on an edge a plain triangle uses stays on that edge: no crack.
+            assert_eq!(d.scale, 0.0, "detail {k} on a boundary edge is displaced");
+            on_boundary += 1;
+        }
+        if d.scale == 0.0 {
+            assert!(off.length() <= 1e-6 * mid.length().max(1.0), "detail {k} off its edge by {off}");
+            continue;
+        }
+        // Displaced along its normal by at most twice the amplitude (relief is in −1…1).
+        let n = Vec3::from_array(v.normal);
+        // (f32: positions resolve to about 1e-7 of their distance from the origin.)
+        let slack = 1e-3 * off.length() + 4e-7 * mid.length();
+        assert!(off.cross(n).length() <= slack, "detail {k} not moved along its normal");
+        assert!(off.length() <= 2.0 * d.scale + 1e-6, "detail {k} moved {} > 2 × {}", off.length(), d.scale);
+        largest = largest.max(off.length() / d.scale);
+        displaced += 1;
+    }
+    assert!(displaced > 0 && on_boundary > 0, "{displaced} displaced, {on_boundary} on boundaries");
+    assert!(largest > 0.2, "the relief between rings adds detail ({largest} of the amplitude at most)");
 }

@@ -1,10 +1,11 @@
-//! Per-frame meshing on the GPU: `mesh_tubes.wgsl` and `mesh_leaves.wgsl` write vertex
+//! Per-frame meshing on the GPU: `mesh_tubes.wgsl` (then `mesh_detail.wgsl` for the
+//! midpoints of subdivided bands) and `mesh_leaves.wgsl` write vertex
 //! buffers the renderer draws directly (no CPU round trip per frame), from the pose seam's
 //! buffers — a GPU method's [`crate::pose::GpuPose`], or a CPU pose uploaded each frame.
 //! The topology ([`MeshLayout`]: rings, index buffers) is uploaded once.
 
 use crate::kernel::{Kernel, output, read_back, upload};
-use crate::shader::{MESH, MESH_LEAVES, MESH_TUBES, NOISE, QUAT, TREE};
+use crate::shader::{MESH, MESH_DETAIL, MESH_LEAVES, MESH_TUBES, NOISE, QUAT, TREE};
 use crate::{GpuContext, GpuError};
 use std::sync::Arc;
 use sylva_core::Tree;
@@ -16,9 +17,11 @@ use wgpu::util::DeviceExt;
 #[derive(Debug)]
 pub struct GpuMesh {
     tubes: Arc<Kernel>,
+    detail_kernel: Arc<Kernel>,
     leaves_kernel: Arc<Kernel>,
     info: wgpu::Buffer,
     rings: wgpu::Buffer,
+    details: wgpu::Buffer,
     segments: wgpu::Buffer,
     leaves: wgpu::Buffer,
     /// Pose buffers used when the pose comes from the CPU.
@@ -39,6 +42,7 @@ pub struct GpuMesh {
     tube_vertex_count: usize,
     leaf_vertex_count: usize,
     ring_count: usize,
+    detail_count: usize,
     leaf_count: usize,
     segment_count: usize,
 }
@@ -75,9 +79,11 @@ impl GpuMesh {
         let n = layout.segments.len();
         Ok(Self {
             tubes: Kernel::cached(ctx, "mesh_tubes", &[QUAT, TREE, NOISE, MESH, MESH_TUBES]),
+            detail_kernel: Kernel::cached(ctx, "mesh_detail", &[NOISE, MESH, MESH_DETAIL]),
             leaves_kernel: Kernel::cached(ctx, "mesh_leaves", &[QUAT, TREE, NOISE, MESH, MESH_LEAVES]),
             info: upload(ctx, "mesh info", &[layout.info()])?,
             rings: upload(ctx, "rings", &layout.rings)?,
+            details: upload(ctx, "mesh details", &layout.details)?,
             segments: upload(ctx, "mesh segments", &layout.segments)?,
             leaves: upload(ctx, "mesh leaves", &layout.leaves)?,
             joint: output::<[f32; 4]>(ctx, "mesh joints", n)?,
@@ -91,6 +97,7 @@ impl GpuMesh {
             tube_vertex_count: layout.tube_vertex_count(),
             leaf_vertex_count: layout.leaf_vertex_count(),
             ring_count: layout.rings.len(),
+            detail_count: layout.details.len(),
             leaf_count: layout.leaves.len(),
             segment_count: n,
         })
@@ -111,6 +118,14 @@ impl GpuMesh {
                 encoder,
                 &[&self.info, &self.rings, &self.segments, joint, acc, &self.tube_vertices],
                 self.ring_count as u32,
+            );
+        }
+        if self.detail_count > 0 {
+            self.detail_kernel.record(
+                ctx,
+                encoder,
+                &[&self.info, &self.details, &self.tube_vertices],
+                self.detail_count as u32,
             );
         }
         if self.leaf_count > 0 {

@@ -349,7 +349,7 @@ fn hsm_structs_match_their_wgsl_twins() {
 
 #[test]
 fn mesh_structs_match_their_wgsl_twins() {
-    use sylva_core::mesh::{RawMeshInfo, RawRing, RawVertex};
+    use sylva_core::mesh::{RawDetail, RawMeshInfo, RawRing, RawVertex};
     use sylva_gpu::shader::{MESH, NOISE};
     let src = compose(&[NOISE, MESH]);
     check_in(
@@ -376,7 +376,22 @@ fn mesh_structs_match_their_wgsl_twins() {
             ("rings", offset_of!(RawMeshInfo, rings)),
             ("leaf_sides", offset_of!(RawMeshInfo, leaf_sides)),
             ("leaves", offset_of!(RawMeshInfo, leaves)),
+            ("details", offset_of!(RawMeshInfo, details)),
             ("_pad", offset_of!(RawMeshInfo, _pad)),
+        ],
+    );
+    check_in(
+        &src,
+        "Detail",
+        size_of::<RawDetail>(),
+        &[
+            ("a", offset_of!(RawDetail, a)),
+            ("b", offset_of!(RawDetail, b)),
+            ("ring", offset_of!(RawDetail, ring)),
+            ("t", offset_of!(RawDetail, t)),
+            ("scale", offset_of!(RawDetail, scale)),
+            ("stem_seed", offset_of!(RawDetail, stem_seed)),
+            ("_pad", offset_of!(RawDetail, _pad)),
         ],
     );
     check_in(

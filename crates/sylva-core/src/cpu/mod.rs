@@ -3,6 +3,7 @@
 
 pub mod akagi;
 pub mod hsm;
+mod mesh_detail;
 mod mesh_leaves;
 mod mesh_tubes;
 pub mod noise;
@@ -15,6 +16,7 @@ pub mod trunk_noise;
 pub mod wind_sample;
 pub mod zioma_rotations;
 
+pub use mesh_detail::mesh_detail;
 pub use mesh_leaves::mesh_leaves;
 pub use mesh_tubes::mesh_tubes;
 pub use segment_ends::segment_ends;

@@ -188,7 +188,14 @@ impl DeformLayout {
 
     /// Kernel constants (`rings` and `sides` are what the kernel reads).
     pub fn info(&self) -> RawMeshInfo {
-        RawMeshInfo { sides: self.params.sides, rings: self.rings.len() as u32, leaf_sides: 0, leaves: 0, _pad: [0; 4] }
+        RawMeshInfo {
+            sides: self.params.sides,
+            rings: self.rings.len() as u32,
+            leaf_sides: 0,
+            leaves: 0,
+            details: 0,
+            _pad: [0; 3],
+        }
     }
 
     /// Number of vertices.

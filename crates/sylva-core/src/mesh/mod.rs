@@ -18,7 +18,15 @@
 //! On segments thicker than [`MeshParams::displace_min_radius`] ring vertices are pushed
 //! along their normal by a procedural bark relief (ridges along the stem broken by noise),
 //! periodic around the stem so the seam stays closed, and zero at the stem's base and tip
-//! rings so joints with parents stay closed.
+//! rings so joints with parents stay closed. Where such a band of quads between two rings
+//! has an edge longer than [`MeshParams::subdivide_min_edge`] (at rest), its triangles are
+//! **subdivided at the edge midpoints** (each into four) and every midpoint vertex is
+//! displaced along its normal by the relief sampled there, less what the corners already
+//! carry: `p = (pₐ + p_b)/2 + n · s · (relief(mid) − (relief(a) + relief(b))/2)` with
+//! `s` = depth × radius. A midpoint on a ring edge shared with a band that is not subdivided
+//! gets `s = 0` — exactly the edge's midpoint — so the surface has no cracks. The midpoint
+//! vertices ([`RawDetail`]) follow the ring vertices in the bark buffer and are computed from
+//! them by `cpu::mesh_detail` ↔ `mesh_detail.wgsl`, one per invocation.
 //!
 //! # Leaves (§2.4)
 //! From each leaf point a leaf polygon: the unit n-gon as two half-circles scaled by the
@@ -62,11 +70,23 @@ pub struct MeshParams {
     /// Segments with a base radius below this (m) are not displaced. Default 0.04 m: the
     /// trunk and thick branches.
     pub displace_min_radius: f32,
+    /// Displaced bands with an edge longer than this at rest (m) are subdivided at their
+    /// edge midpoints. Default 0.08 m: the trunk's and thick branches' long quads get the
+    /// relief in between their rings, thin ones stay as they are. Infinity turns it off.
+    pub subdivide_min_edge: f32,
 }
 
 impl Default for MeshParams {
     fn default() -> Self {
-        Self { sides: 8, samples: 3, leaf_sides: 8, leaves: true, bark_depth: 0.06, displace_min_radius: 0.04 }
+        Self {
+            sides: 8,
+            samples: 3,
+            leaf_sides: 8,
+            leaves: true,
+            bark_depth: 0.06,
+            displace_min_radius: 0.04,
+            subdivide_min_edge: 0.08,
+        }
     }
 }
 
@@ -125,8 +145,31 @@ pub struct RawMeshInfo {
     pub leaf_sides: u32,
     /// Number of leaves.
     pub leaves: u32,
+    /// Number of midpoint vertices of subdivided bands.
+    pub details: u32,
     /// Padding.
-    pub _pad: [u32; 4],
+    pub _pad: [u32; 3],
+}
+
+/// A midpoint vertex of a subdivided band (§2.3), 32 bytes. WGSL: `struct Detail` in
+/// `mesh.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawDetail {
+    /// First end of the edge (a ring vertex).
+    pub a: u32,
+    /// Second end of the edge (a ring vertex).
+    pub b: u32,
+    /// Ring whose segment the midpoint lies on (for skinning).
+    pub ring: u32,
+    /// Parameter along that segment, 0…1 (for skinning).
+    pub t: f32,
+    /// Relief amplitude at the midpoint, m (depth × radius; 0 on a boundary edge).
+    pub scale: f32,
+    /// Seed of the stem's relief pattern.
+    pub stem_seed: u32,
+    /// Padding.
+    pub _pad: [u32; 2],
 }
 
 /// One output vertex, 32 bytes: position and `u`, normal and `v`. WGSL: `struct Vertex` in
@@ -151,6 +194,8 @@ pub struct MeshLayout {
     pub params: MeshParams,
     /// Ring table (per stem, base to tip).
     pub rings: Vec<RawRing>,
+    /// Midpoint vertices of subdivided bands; bark vertex `rings × (sides + 1) + d`.
+    pub details: Vec<RawDetail>,
     /// Bark triangle indices into the tube vertices.
     pub tube_indices: Vec<u32>,
     /// Leaf triangle indices into the leaf vertices.
@@ -164,7 +209,7 @@ pub struct MeshLayout {
 /// One frame's vertices.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshFrame {
-    /// Bark vertices (`rings × (sides + 1)`).
+    /// Bark vertices (`rings × (sides + 1)`, then one per [`RawDetail`]).
     pub tubes: Vec<RawVertex>,
     /// Leaf vertices (`leaves × (leaf_sides + 1)`).
     pub leaves: Vec<RawVertex>,
@@ -201,6 +246,9 @@ impl MeshLayout {
         if !(params.bark_depth.is_finite() && (0.0..=0.5).contains(&params.bark_depth)) {
             return bad("bark_depth", params.bark_depth.to_string(), "0 to 0.5");
         }
+        if params.subdivide_min_edge.is_nan() || params.subdivide_min_edge <= 0.0 {
+            return bad("subdivide_min_edge", params.subdivide_min_edge.to_string(), "a positive length in m");
+        }
         let s = &tree.segments;
         let st = &tree.stems;
         let ring_count: u64 = st.segment_count.iter().map(|&n| n as u64 * params.samples as u64 + 1).sum();
@@ -213,6 +261,7 @@ impl MeshLayout {
         }
         let mut rings = Vec::with_capacity(ring_count as usize);
         let mut tube_indices = Vec::new();
+        let mut details = Vec::new();
         let sides = params.sides;
         for k in 0..st.len() {
             let first = st.first_segment[k] as usize;
@@ -247,15 +296,77 @@ impl MeshLayout {
             }
             let ring_end = rings.len() as u32;
             let stride = sides + 1;
+            // §2.3: which bands (ring r → r + 1) are subdivided.
+            let split: Vec<bool> = (first_ring..ring_end - 1)
+                .map(|r| {
+                    let (lo, hi) = (&rings[r as usize], &rings[r as usize + 1]);
+                    let around = std::f32::consts::TAU * lo.radius.max(hi.radius) / sides as f32;
+                    let along = s.length[lo.segment as usize] / params.samples as f32;
+                    lo.relief > 0.0 && hi.relief > 0.0 && around.max(along) > params.subdivide_min_edge
+                })
+                .collect();
+            let detail_base = ring_count as u32 * stride;
             for r in first_ring..ring_end - 1 {
-                for j in 0..sides {
-                    let a = r * stride + j;
-                    let b = a + 1;
-                    let c = a + stride;
+                let band = (r - first_ring) as usize;
+                if !split[band] {
+                    for j in 0..sides {
+                        let a = r * stride + j;
+                        let b = a + 1;
+                        let c = a + stride;
+                        let d = c + 1;
+                        tube_indices.extend_from_slice(&[a, c, d, a, d, b]);
+                    }
+                    continue;
+                }
+                let (lo, hi) = (rings[r as usize], rings[r as usize + 1]);
+                let t_hi = if hi.segment == lo.segment { hi.t } else { 1.0 };
+                let inner = lo.relief * 0.5 * (lo.radius + hi.radius);
+                // Ring-edge midpoints are displaced only where the band across the ring is
+                // subdivided too (else they stay on the straight edge: no crack).
+                let below = band > 0 && split[band - 1];
+                let above = band + 1 < split.len() && split[band + 1];
+                let mut push = |a: u32, b: u32, ring: u32, t: f32, scale: f32| {
+                    details.push(RawDetail { a, b, ring, t, scale, stem_seed: lo.stem_seed, _pad: [0; 2] });
+                    detail_base + details.len() as u32 - 1
+                };
+                let ab: Vec<u32> = (0..sides)
+                    .map(|j| {
+                        let a = r * stride + j;
+                        push(a, a + 1, r, lo.t, if below { lo.relief * lo.radius } else { 0.0 })
+                    })
+                    .collect();
+                let cd: Vec<u32> = (0..sides)
+                    .map(|j| {
+                        let c = (r + 1) * stride + j;
+                        push(c, c + 1, r + 1, hi.t, if above { hi.relief * hi.radius } else { 0.0 })
+                    })
+                    .collect();
+                let t_mid = 0.5 * (lo.t + t_hi);
+                let ac: Vec<u32> =
+                    (0..=sides).map(|k| push(r * stride + k, (r + 1) * stride + k, r, t_mid, inner)).collect();
+                let ad: Vec<u32> =
+                    (0..sides).map(|j| push(r * stride + j, (r + 1) * stride + j + 1, r, t_mid, inner)).collect();
+                for j in 0..sides as usize {
+                    let a = r * stride + j as u32;
+                    let (b, c) = (a + 1, a + stride);
                     let d = c + 1;
-                    tube_indices.extend_from_slice(&[a, c, d, a, d, b]);
+                    let (mab, mcd, mac, mbd, mad) = (ab[j], cd[j], ac[j], ac[j + 1], ad[j]);
+                    tube_indices.extend_from_slice(&[
+                        // (a, c, d) in four
+                        a, mac, mad, mac, c, mcd, mad, mcd, d, mac, mcd, mad, //
+                        // (a, d, b) in four
+                        a, mad, mab, mad, d, mbd, mab, mbd, b, mad, mbd, mab,
+                    ]);
+                }
+                let vertices = ring_count * stride as u64 + details.len() as u64;
+                if vertices > MAX_VERTICES {
+                    return Err(MeshError::TooLarge { vertices, limit: MAX_VERTICES });
                 }
             }
+        }
+        let tube_vertices = tube_vertices + details.len() as u64;
+        if tube_vertices > MAX_VERTICES {
+            return Err(MeshError::TooLarge { vertices: tube_vertices, limit: MAX_VERTICES });
         }
         let mut leaf_indices = Vec::new();
         if params.leaves {
@@ -272,6 +383,7 @@ impl MeshLayout {
         Ok(Self {
             params,
             rings,
+            details,
             tube_indices,
             leaf_indices,
             segments: tree.raw_segments(),
@@ -289,9 +401,11 @@ impl MeshLayout {
             expected: "at least one layout",
         })?;
         let params = first.params;
+        let total_ring_vertices: u32 = layouts.iter().map(|l| l.rings.len() as u32).sum::<u32>() * (params.sides + 1);
         let mut out = MeshLayout {
             params,
             rings: Vec::new(),
+            details: Vec::new(),
             tube_indices: Vec::new(),
             leaf_indices: Vec::new(),
             segments: Vec::new(),
@@ -307,14 +421,32 @@ impl MeshLayout {
             }
             let seg = out.segments.len() as u32;
             let shift = |i: u32| if i == NONE { NONE } else { i + seg };
-            let (tv, lv) = (out.tube_vertex_count() as u32, out.leaf_vertex_count() as u32);
+            // Bark vertices are [every ring's][every detail]: ring vertices shift by the
+            // rings before, midpoints move behind all rings.
+            let (rings_before, details_before) = (out.rings.len() as u32, out.details.len() as u32);
+            let ring_vertices = l.rings.len() as u32 * (params.sides + 1);
+            let ring_shift = rings_before * (params.sides + 1);
+            let remap = move |i: u32| {
+                if i < ring_vertices {
+                    i + ring_shift
+                } else {
+                    total_ring_vertices + details_before + (i - ring_vertices)
+                }
+            };
+            let lv = out.leaf_vertex_count() as u32;
             out.rings.extend(l.rings.iter().map(|r| RawRing {
                 segment: r.segment + seg,
                 prev: shift(r.prev),
                 next: shift(r.next),
                 ..*r
             }));
-            out.tube_indices.extend(l.tube_indices.iter().map(|i| i + tv));
+            out.details.extend(l.details.iter().map(|d| RawDetail {
+                a: d.a + ring_shift,
+                b: d.b + ring_shift,
+                ring: d.ring + rings_before,
+                ..*d
+            }));
+            out.tube_indices.extend(l.tube_indices.iter().map(|&i| remap(i)));
             out.leaf_indices.extend(l.leaf_indices.iter().map(|i| i + lv));
             out.segments.extend(l.segments.iter().map(|s| RawSegment { parent: shift(s.parent), ..*s }));
             out.leaves.extend(l.leaves.iter().map(|f| RawLeaf { segment: f.segment + seg, ..*f }));
@@ -370,13 +502,14 @@ impl MeshLayout {
             rings: self.rings.len() as u32,
             leaf_sides: self.params.leaf_sides,
             leaves: self.leaves.len() as u32,
-            _pad: [0; 4],
+            details: self.details.len() as u32,
+            _pad: [0; 3],
         }
     }
 
     /// Number of bark vertices.
     pub fn tube_vertex_count(&self) -> usize {
-        self.rings.len() * (self.params.sides as usize + 1)
+        self.rings.len() * (self.params.sides as usize + 1) + self.details.len()
     }
 
     /// Number of leaf vertices.
@@ -399,7 +532,9 @@ impl MeshLayout {
     pub fn mesh_raw(&self, joint: &[[f32; 4]], acc: &[[f32; 4]]) -> MeshFrame {
         let info = self.info();
         let mut tubes = vec![RawVertex::zeroed(); self.tube_vertex_count()];
-        crate::cpu::mesh_tubes(&info, &self.rings, &self.segments, joint, acc, &mut tubes);
+        let ring_vertices = self.rings.len() * (self.params.sides as usize + 1);
+        crate::cpu::mesh_tubes(&info, &self.rings, &self.segments, joint, acc, &mut tubes[..ring_vertices]);
+        crate::cpu::mesh_detail(&info, &self.details, &mut tubes);
         let mut leaves = vec![RawVertex::zeroed(); self.leaf_vertex_count()];
         crate::cpu::mesh_leaves(&info, &self.leaves, &self.segments, joint, acc, &mut leaves);
         MeshFrame { tubes, leaves }

@@ -72,16 +72,21 @@ impl SkinLayout {
         let rest = layout.mesh_raw(&joint, &acc);
         let stride = layout.params.sides as usize + 1;
         let mut tube_skin = Vec::with_capacity(rest.tubes.len());
-        for r in &layout.rings {
-            let (bone1, weight) = if r.t < 0.5 && r.prev != NONE {
-                (r.prev, 0.5 - r.t)
-            } else if r.t > 0.5 && r.next != NONE {
-                (r.next, r.t - 0.5)
+        let bones = |r: &super::RawRing, t: f32| {
+            let (bone1, weight) = if t < 0.5 && r.prev != NONE {
+                (r.prev, 0.5 - t)
+            } else if t > 0.5 && r.next != NONE {
+                (r.next, t - 0.5)
             } else {
                 (r.segment, 0.0)
             };
-            tube_skin.extend(std::iter::repeat_n(RawSkin { bone0: r.segment, bone1, weight, _pad: 0 }, stride));
+            RawSkin { bone0: r.segment, bone1, weight, _pad: 0 }
+        };
+        for r in &layout.rings {
+            tube_skin.extend(std::iter::repeat_n(bones(r, r.t), stride));
         }
+        // Midpoints of subdivided bands: on their ring's segment at their own parameter.
+        tube_skin.extend(layout.details.iter().map(|d| bones(&layout.rings[d.ring as usize], d.t)));
         let leaf_stride = layout.params.leaf_sides as usize + 1;
         let leaf_skin = layout
             .leaves

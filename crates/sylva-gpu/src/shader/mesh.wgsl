@@ -1,5 +1,6 @@
-// Per-frame meshing (Akagi §2.2–2.4): structs shared by mesh_tubes and mesh_leaves, twins
-// of sylva_core::mesh::{RawRing, RawMeshInfo, RawVertex}, and the bark relief.
+// Per-frame meshing (Akagi §2.2–2.4): structs shared by mesh_tubes, mesh_detail and
+// mesh_leaves, twins of sylva_core::mesh::{RawRing, RawMeshInfo, RawDetail, RawVertex}, and
+// the bark relief.
 
 const TAU: f32 = 6.283185307179586;
 
@@ -19,7 +20,19 @@ struct MeshInfo {
     rings: u32,
     leaf_sides: u32,
     leaves: u32,
-    _pad: vec4<u32>,
+    details: u32,
+    _pad: array<u32, 3>,
+}
+
+// A midpoint vertex of a subdivided band (sylva_core::mesh::RawDetail).
+struct Detail {
+    a: u32,
+    b: u32,
+    ring: u32,
+    t: f32,
+    scale: f32,
+    stem_seed: u32,
+    _pad: array<u32, 2>,
 }
 
 struct Vertex {

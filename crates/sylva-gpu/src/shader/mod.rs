@@ -51,10 +51,12 @@ pub const HSM_INTEGRATE: &str = include_str!("hsm_integrate.wgsl");
 pub const HSM_PARTICLES: &str = include_str!("hsm_particles.wgsl");
 /// Kernel: seam rotations from HSM's clusters.
 pub const HSM_POSE: &str = include_str!("hsm_pose.wgsl");
-/// Per-frame meshing structs (`Ring`, `MeshInfo`, `Vertex`) and the bark relief.
+/// Per-frame meshing structs (`Ring`, `MeshInfo`, `Detail`, `Vertex`) and the bark relief.
 pub const MESH: &str = include_str!("mesh.wgsl");
 /// Kernel: bark vertices of every tube.
 pub const MESH_TUBES: &str = include_str!("mesh_tubes.wgsl");
+/// Kernel: midpoint vertices of subdivided bark bands (§2.3).
+pub const MESH_DETAIL: &str = include_str!("mesh_detail.wgsl");
 /// Kernel: leaf-polygon vertices.
 pub const MESH_LEAVES: &str = include_str!("mesh_leaves.wgsl");
 /// Kernel: two-bone skinning of a rest mesh, instance-major.
@@ -84,6 +86,7 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("hsm_particles", &[QUAT, HSM, HSM_GATHER, HSM_ADVANCE, HSM_PARTICLES]),
     ("hsm_pose", &[QUAT, TREE, HSM, HSM_POSE]),
     ("mesh_tubes", &[QUAT, TREE, NOISE, MESH, MESH_TUBES]),
+    ("mesh_detail", &[NOISE, MESH, MESH_DETAIL]),
     ("mesh_leaves", &[QUAT, TREE, NOISE, MESH, MESH_LEAVES]),
     ("skin_vertices", &[QUAT, NOISE, MESH, SKIN_VERTICES]),
     ("skjermo_deform", &[QUAT, TREE, NOISE, MESH, SKJERMO, SKJERMO_DEFORM]),

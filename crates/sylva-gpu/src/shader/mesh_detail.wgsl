@@ -1,0 +1,28 @@
+// mesh_detail: one midpoint vertex of a subdivided band per invocation (Akagi §2.3): the
+// midpoint of its edge's two ring vertices (written by mesh_tubes before), the mean normal,
+// and the bark relief sampled at the midpoint less the mean of what the ends carry.
+// CPU twin: sylva_core::cpu::mesh_detail (same bindings, same loop body).
+
+@group(0) @binding(0) var<storage, read> info: MeshInfo;
+@group(0) @binding(1) var<storage, read> detail: array<Detail>;
+@group(0) @binding(2) var<storage, read_write> vertex: array<Vertex>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * 64u;
+    if (i >= info.details) {
+        return;
+    }
+    let d = detail[i];
+    let a = vertex[d.a];
+    let b = vertex[d.b];
+    let normal = normalize(a.normal + b.normal);
+    let u = 0.5 * (a.u + b.u);
+    let v = 0.5 * (a.v + b.v);
+    var p = (a.position + b.position) * 0.5;
+    if (d.scale != 0.0) {
+        let ends = 0.5 * (bark_relief(a.u, a.v, d.stem_seed) + bark_relief(b.u, b.v, d.stem_seed));
+        p += normal * (d.scale * (bark_relief(u, v, d.stem_seed) - ends));
+    }
+    vertex[info.rings * (info.sides + 1u) + i] = Vertex(p, u, normal, v);
+}
