@@ -458,3 +458,49 @@ fn export_rejects_bad_input_and_leaves_no_file() {
     let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
     assert!(left.is_empty(), "files left behind: {left:?}");
 }
+
+/// The MP4 path without a real ffmpeg: a stand-in `ffmpeg` on PATH answers `-version` and
+/// copies its stdin to its output file (the last argument), so the test sees exactly what
+/// Sylva pipes — every frame, raw RGBA at the scene's size — and that the file is renamed
+/// into place only when complete.
+#[test]
+fn mp4_pipe_hands_ffmpeg_every_frame_and_renames_when_done() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let bin = dir.path().join("bin");
+    std::fs::create_dir(&bin).unwrap();
+    let fake = bin.join("ffmpeg");
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\n[ \"$1\" = -version ] && exit 0\nfor last; do :; done\necho \"$@\" > \"$last.args\"\ncat > \"$last\"\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let scene = TINY_SCENE.replace("mp4 = false", "mp4 = true").replace("seconds = 20", "seconds = 0.03");
+    std::fs::write(dir.path().join("tiny.toml"), scene).unwrap();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    let out = Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .current_dir(dir.path())
+        .env("PATH", path)
+        .args(["render", "tiny.toml", "--no-png"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mp4 = std::fs::read(dir.path().join("out/tiny.mp4")).unwrap();
+    let frames = 3; // seconds × fps frames: 0.03 s at 100 fps, at t = 0, 0.01, 0.02 s
+    assert_eq!(mp4.len(), frames * 64 * 48 * 4, "raw RGBA frames piped");
+    assert!(mp4.chunks(4).any(|p| p[1] > p[0] + 20), "the frames show green leaves");
+    let args = std::fs::read_dir(dir.path().join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.to_string_lossy().ends_with(".args"))
+        .map(|p| std::fs::read_to_string(p).unwrap())
+        .unwrap();
+    assert!(args.contains("-s 64x48") && args.contains("-pix_fmt rgba") && args.contains("-r 100"), "{args}");
+    let tmp: Vec<_> = std::fs::read_dir(dir.path().join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp") && !n.ends_with(".args"))
+        .collect();
+    assert!(tmp.is_empty(), "{tmp:?}");
+}
