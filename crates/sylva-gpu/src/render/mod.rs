@@ -182,6 +182,7 @@ pub struct Renderer {
     bark: wgpu::RenderPipeline,
     leaf: wgpu::RenderPipeline,
     shadow: wgpu::RenderPipeline,
+    shadow_leaf: wgpu::RenderPipeline,
     color: wgpu::TextureView,
     resolve: wgpu::Texture,
     depth: wgpu::TextureView,
@@ -379,28 +380,37 @@ impl Renderer {
             depth(true, wgpu::CompareFunction::Less),
         );
         let leaf = pipeline("leaf", "vs_tree", "fs_leaf", &layouts, None, depth(true, wgpu::CompareFunction::Less));
-        let shadow = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("shadow"),
-            layout: Some(&shadow_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_shadow"),
-                compilation_options: Default::default(),
-                buffers: &layouts,
-            },
-            primitive: Default::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: wgpu::DepthBiasState { constant: 2, slope_scale: 2.0, clamp: 0.0 },
-            }),
-            multisample: Default::default(),
-            fragment: None,
-            multiview_mask: None,
-            cache: None,
-        });
+        let shadow_pipeline = |label, vs, fs: Option<&str>| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&shadow_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(vs),
+                    compilation_options: Default::default(),
+                    buffers: &layouts,
+                },
+                primitive: Default::default(),
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: wgpu::DepthBiasState { constant: 2, slope_scale: 2.0, clamp: 0.0 },
+                }),
+                multisample: Default::default(),
+                fragment: fs.map(|fs| wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let shadow = shadow_pipeline("shadow", "vs_shadow", None);
+        let shadow_leaf = shadow_pipeline("leaf shadow", "vs_shadow_leaf", Some("fs_shadow_leaf"));
         let size = wgpu::Extent3d { width: settings.width, height: settings.height, depth_or_array_layers: 1 };
         let texture = |label, format, sample_count, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
@@ -442,6 +452,7 @@ impl Renderer {
             bark,
             leaf,
             shadow,
+            shadow_leaf,
             color,
             resolve,
             depth: depth_view,
@@ -548,9 +559,8 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.shadow);
             pass.set_bind_group(0, &self.globals_bind, &[]);
-            Self::draw_trees(&mut pass, items, None, None);
+            Self::draw_trees(&mut pass, items, Some(&self.shadow), Some(&self.shadow_leaf));
         }
         let msaa = self.settings.msaa > 1;
         let resolve_view = self.resolve.create_view(&Default::default());
