@@ -1,16 +1,15 @@
 //! `sylva export`: a tree as glTF 2.0 (`.glb` or `.gltf`) with a skin and wind baked from
 //! any method, hierarchy attributes for engine-side wind, and levels of detail.
 
-use crate::simulate_cmd::Method;
+use crate::simulate_cmd::{Method, TreeWindArgs};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Instant;
+use sylva_core::Tree;
 use sylva_core::export::{BakeParams, DEFAULT_LODS, GltfOptions, JointMode, Lod, bake, write_gltf};
 use sylva_core::scene::MethodName;
-use sylva_core::species::{DEFAULT_SPECIES, SpeciesSource};
 use sylva_core::wind::WindScene;
-use sylva_core::{Limits, Tree};
 
 /// Joints of the skin.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,18 +24,9 @@ pub enum Joints {
 /// Arguments of `sylva export`.
 #[derive(clap::Args, Debug)]
 pub struct ExportArgs {
-    /// A preset name, a Weber–Penn TOML file or an L-system grammar file.
-    #[arg(long, short, default_value = DEFAULT_SPECIES)]
-    pub species: String,
-    /// Random seed of the tree (and of Zioma's branch phases).
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Animation method baked into the clip.
-    #[arg(long, value_enum, default_value = "zioma")]
-    pub method: Method,
-    /// A wind preset (`gusty`, `blast`) or a scene TOML file.
-    #[arg(long, default_value = "gusty")]
-    pub wind: String,
+    /// Tree, the method baked into the clip, and wind.
+    #[command(flatten)]
+    pub tree: TreeWindArgs,
     /// Clip length, s.
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     pub seconds: f32,
@@ -105,14 +95,14 @@ impl Method {
 /// Runs the command; returns the file written.
 pub fn run(a: &ExportArgs) -> Result<PathBuf> {
     let out = a.out.clone().unwrap_or_else(|| {
-        let stem = std::path::Path::new(&a.species)
+        let stem = std::path::Path::new(&a.tree.species)
             .file_stem()
             .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
         PathBuf::from("out").join(format!("{stem}.glb"))
     });
     let params = BakeParams {
-        method: a.method.name(),
-        seed: a.seed,
+        method: a.tree.method.name(),
+        seed: a.tree.seed,
         seconds: a.seconds,
         fps: a.fps,
         looped: a.looped,
@@ -128,8 +118,7 @@ pub fn run(a: &ExportArgs) -> Result<PathBuf> {
         max_joints: a.max_joints,
         lods: if a.lods.is_empty() { DEFAULT_LODS.to_vec() } else { a.lods.clone() },
     };
-    let tree = SpeciesSource::resolve(&a.species)?.generate(a.seed, &Limits::default(), None)?;
-    let wind = WindScene::resolve(&a.wind)?;
+    let (tree, wind) = a.tree.resolve()?;
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }

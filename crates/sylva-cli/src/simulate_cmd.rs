@@ -38,13 +38,13 @@ pub enum Backend {
     Gpu,
 }
 
-/// Arguments of `sylva simulate`.
+/// The tree, method and wind a command animates (`sylva simulate`, `sylva export`).
 #[derive(clap::Args, Debug)]
-pub struct SimulateArgs {
+pub struct TreeWindArgs {
     /// A preset name, a Weber–Penn TOML file or an L-system grammar file.
     #[arg(long, short, default_value = DEFAULT_SPECIES)]
     pub species: String,
-    /// Random seed of the tree.
+    /// Random seed of the tree (and of Zioma's branch phases).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Animation method.
@@ -53,6 +53,22 @@ pub struct SimulateArgs {
     /// A wind preset (`gusty`, `blast`) or a scene TOML file.
     #[arg(long, default_value = "gusty")]
     pub wind: String,
+}
+
+impl TreeWindArgs {
+    /// Generates the tree and loads the wind.
+    pub fn resolve(&self) -> Result<(Tree, WindScene)> {
+        let tree = SpeciesSource::resolve(&self.species)?.generate(self.seed, &Limits::default(), None)?;
+        Ok((tree, WindScene::resolve(&self.wind)?))
+    }
+}
+
+/// Arguments of `sylva simulate`.
+#[derive(clap::Args, Debug)]
+pub struct SimulateArgs {
+    /// Tree, method and wind.
+    #[command(flatten)]
+    pub tree: TreeWindArgs,
     /// Simulated time, s.
     #[arg(long, default_value_t = 10.0)]
     pub seconds: f32,
@@ -100,15 +116,14 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         bail!("{} frames requested; the limit is {MAX_FRAMES} (lower --seconds or --fps)", frames_f);
     }
     let frames = frames_f as usize + 1;
-    let tree = SpeciesSource::resolve(&a.species)?.generate(a.seed, &Limits::default(), None)?;
-    let wind = WindScene::resolve(&a.wind)?;
+    let (tree, wind) = a.tree.resolve()?;
     let n = tree.segments.len();
     let track: Vec<usize> = if a.track.is_empty() { default_track(&tree) } else { a.track.clone() };
     if let Some(&bad) = track.iter().find(|&&i| i >= n) {
         bail!("--track {bad}: the tree has {n} segments (0..{})", n - 1);
     }
-    if a.trunk_only && a.method != Method::Zioma {
-        bail!("--trunk-only is Zioma's simulation LOD; {:?} has none", a.method);
+    if a.trunk_only && a.tree.method != Method::Zioma {
+        bail!("--trunk-only is Zioma's simulation LOD; {:?} has none", a.tree.method);
     }
     let ctx = match a.backend {
         Backend::Cpu => None,
@@ -122,11 +137,11 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let (tree_ref, wind_ref) = (&tree, &wind);
     // One closure per method and backend: (time, step since the last frame) → pose.
     type Runner<'a> = Box<dyn FnMut(f32, f32) -> Result<Pose> + 'a>;
-    let mut runner: Runner<'_> = match (a.method, ctx) {
+    let mut runner: Runner<'_> = match (a.tree.method, ctx) {
         (Method::Zioma, ctx) => {
             let params = ZiomaParams {
                 lod: if a.trunk_only { Lod::TrunkOnly } else { Lod::Full },
-                seed: a.seed,
+                seed: a.tree.seed,
                 ..Default::default()
             };
             let method = Zioma::new(tree_ref, params);
@@ -271,9 +286,9 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         "{} (seed {}), {:?} on {:?}, wind `{}`: {} frames over {} s in {:.2} s ({:.2} ms per frame)",
         tree.name,
         tree.seed,
-        a.method,
+        a.tree.method,
         a.backend,
-        a.wind,
+        a.tree.wind,
         frames,
         a.seconds,
         elapsed,

@@ -238,22 +238,23 @@ fn check_frames(t: &Tree, c: &Clip, what: &str) {
     assert_eq!(rest.len(), rb.positions.len());
 }
 
+/// Number of translation channels in the document's animation.
+fn translation_channels(doc: &sylva_core::export::GltfDocument) -> usize {
+    use gltf::json::{animation::Property, validation::Checked};
+    doc.root.animations[0]
+        .channels
+        .iter()
+        .filter(|ch| matches!(ch.target.path, Checked::Valid(Property::Translation)))
+        .count()
+}
+
 #[test]
 fn skin_and_animation_read_back_reproduce_sylvas_mesh_at_frame_k_rotation_channels() {
     // Akagi keeps segments attached by forward kinematics: rotation channels only.
     let t = tree("palm");
     let c = clip(&t, MethodName::Akagi, 1.0, false);
     let doc = build_gltf(&t, Some(&c), &GltfOptions::default()).unwrap();
-    let translations = doc.root.animations[0]
-        .channels
-        .iter()
-        .filter(|ch| {
-            matches!(
-                ch.target.path,
-                gltf::json::validation::Checked::Valid(gltf::json::animation::Property::Translation)
-            )
-        })
-        .count();
+    let translations = translation_channels(&doc);
     assert_eq!(translations, 0, "forward kinematics needs no translation channels");
     check_frames(&t, &c, "palm, Akagi");
 }
@@ -273,16 +274,7 @@ fn skin_and_animation_read_back_reproduce_sylvas_mesh_at_frame_k_with_translatio
         }
     }
     let doc = build_gltf(&t, Some(&c), &GltfOptions::default()).unwrap();
-    let translations = doc.root.animations[0]
-        .channels
-        .iter()
-        .filter(|ch| {
-            matches!(
-                ch.target.path,
-                gltf::json::validation::Checked::Valid(gltf::json::animation::Property::Translation)
-            )
-        })
-        .count();
+    let translations = translation_channels(&doc);
     assert_eq!(translations, t.segments.len(), "every joint moved off its parent");
     check_frames(&t, &c, "palm, HSM with joints moved");
 }

@@ -371,8 +371,8 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         let skinned = SkinLayout::new(&layout);
         let before = b.bin.len();
         let mut primitives = Vec::new();
-        let bark = Geometry::new(&skinned.tube_rest, &skinned.tube_skin, &layout.tube_indices, |v, s| {
-            hier.bark(tree, s.bone0 as usize, v)
+        let bark = Geometry::new(&skinned.tube_rest, &skinned.tube_skin, &layout.tube_indices, |_, s| {
+            hier.bark(tree, s.bone0 as usize)
         });
         primitives.push(b.primitive(&bark, &rig, clip.is_some(), bark_mat));
         let leaf_stride = layout.params.leaf_sides as usize + 1;
@@ -552,7 +552,7 @@ impl Hierarchy {
         Self { stems }
     }
 
-    fn bark(&self, tree: &Tree, segment: usize, _vertex: usize) -> Element {
+    fn bark(&self, tree: &Tree, segment: usize) -> Element {
         self.stems[tree.segments.stem[segment] as usize]
     }
 

@@ -364,10 +364,6 @@ impl MeshLayout {
                 }
             }
         }
-        let tube_vertices = tube_vertices + details.len() as u64;
-        if tube_vertices > MAX_VERTICES {
-            return Err(MeshError::TooLarge { vertices: tube_vertices, limit: MAX_VERTICES });
-        }
         let mut leaf_indices = Vec::new();
         if params.leaves {
             let stride = params.leaf_sides + 1;
