@@ -9,7 +9,7 @@
 //! per submission, wall clock to completion. The paper's figures include drawing (about
 //! 0.1 % of its CPU time); ours time generation only.
 
-use crate::bench_cmd::{Series, cpu_bandwidth, cpu_model, gpu_bandwidth, measure, plot_series, write_atomic};
+use crate::bench_cmd::{Env, Machine, Series, markdown_head, measure, measure_gpu, plot_series, write_atomic};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
@@ -51,22 +51,24 @@ pub struct AkagiRow {
     pub gpu_bandwidth_fraction: Option<f64>,
 }
 
-fn ms(r: crate::bench_cmd::Rate) -> [f64; 3] {
-    [1e3 / r.median, 1e3 / r.max, 1e3 / r.min]
-}
-
-fn cell(v: Option<[f64; 3]>) -> String {
+pub(crate) fn cell(v: Option<[f64; 3]>) -> String {
     v.map_or("–".into(), |[m, lo, hi]| format!("{m:.2} ({lo:.2}–{hi:.2})"))
 }
 
+/// A table's JSON file: its name, the machine and the rows.
+#[derive(Serialize)]
+pub(crate) struct Report<'a, R: Serialize> {
+    /// The table's name on the command line.
+    pub table: &'static str,
+    /// Where and when it ran.
+    pub machine: &'a Machine,
+    /// The rows, smallest first.
+    pub rows: &'a [R],
+}
+
 /// Runs the table; returns the files written.
-pub fn run(
-    quick: bool,
-    budget: f64,
-    time_cpu: bool,
-    ctx: Option<&'static sylva_gpu::GpuContext>,
-    out_dir: &std::path::Path,
-) -> Result<Vec<PathBuf>> {
+pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
+    let (quick, budget, time_cpu, ctx) = (env.quick, env.budget, env.time_cpu, env.ctx);
     let rows = if quick { &AKAGI_TABLE_2[..3] } else { &AKAGI_TABLE_2[..] };
     let wind = WindScene::resolve("gusty")?;
     let (fields, waves) = wind.pack();
@@ -77,11 +79,7 @@ pub fn run(
     let mut pool: Vec<(Tree, MeshLayout)> = Vec::new();
     let mut palms: Vec<(Tree, MeshLayout)> = Vec::new();
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-    let cpu_bw = cpu_bandwidth();
-    let gpu_bw = match ctx {
-        Some(c) => Some(gpu_bandwidth(c)?),
-        None => None,
-    };
+    let (cpu_bw, gpu_bw) = (env.machine.cpu_bandwidth, env.machine.gpu_bandwidth);
     let bar = ProgressBar::new(rows.len() as u64).with_style(
         ProgressStyle::with_template("{msg:>10} [{bar:30}] {pos}/{len} rows, {elapsed}").expect("valid template"),
     );
@@ -159,13 +157,12 @@ pub fn run(
                 let mesh = sylva_gpu::mesh::GpuMesh::new(c, &layout)?;
                 let jb = sylva_gpu::kernel::upload(c, "bench joints", &joint)?;
                 let ab = sylva_gpu::kernel::upload(c, "bench rotations", &acc)?;
-                Some(measure(budget, |n| {
+                Some(measure_gpu(budget, c, |n| {
                     let mut e = c.device.create_command_encoder(&Default::default());
                     for _ in 0..n {
                         mesh.record(c, &mut e, &jb, &ab);
                     }
                     c.queue.submit([e.finish()]);
-                    c.wait()?;
                     Ok(())
                 })?)
             }
@@ -179,9 +176,9 @@ pub fn run(
             vertices,
             trees: members.len(),
             bytes_per_frame: bytes,
-            cpu_one_ms: cpu_one.map(ms),
-            cpu_all_ms: cpu_all.map(ms),
-            gpu_ms: gpu.map(ms),
+            cpu_one_ms: cpu_one.map(|r| r.ms()),
+            cpu_all_ms: cpu_all.map(|r| r.ms()),
+            gpu_ms: gpu.map(|r| r.ms()),
             cpu_bandwidth_fraction: cpu_all.map(|r| r.median * bytes as f64 / cpu_bw),
             gpu_bandwidth_fraction: gpu.zip(gpu_bw).map(|(r, b)| r.median * bytes as f64 / b),
         };
@@ -202,20 +199,7 @@ pub fn run(
     }
     bar.finish_and_clear();
 
-    let machine = format!(
-        "{} ({} threads), CPU copy bandwidth {:.1} GB/s{}",
-        cpu_model(),
-        rayon::current_num_threads(),
-        cpu_bw / 1e9,
-        match (ctx, gpu_bw) {
-            (Some(c), Some(b)) => format!("; GPU {}, copy bandwidth {:.1} GB/s", c.summary, b / 1e9),
-            _ => String::new(),
-        }
-    );
-    let date = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
-    let command = std::env::args().collect::<Vec<_>>().join(" ");
-    let mut md = "### Akagi & Kitajima Table 2: mesh regeneration per frame (akagi-t2)\n\n".to_string();
-    md += &format!("Machine: {machine}.\nDate {date}. Command `{command}`.\n\n");
+    let mut md = markdown_head("Akagi & Kitajima Table 2: mesh regeneration per frame", "akagi-t2", env.machine);
     md += "ms per frame, median (min–max). The paper: Core2 QX9650 one thread, GeForce GTX 280, generation + drawing.\n\n";
     md += "| paper triangles | paper CPU ms | paper GPU ms | paper CPU/GPU | triangles | trees | MB/frame | CPU 1 thread ms | CPU all threads ms | CPU % of bandwidth | GPU ms | GPU % of bandwidth | CPU 1 thread / GPU | CPU all / GPU |\n";
     md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
@@ -242,21 +226,8 @@ pub fn run(
             ratio(r.cpu_all_ms, r.gpu_ms),
         );
     }
-    #[derive(Serialize)]
-    struct Report<'a> {
-        table: &'static str,
-        machine: &'a str,
-        date: &'a str,
-        command: &'a str,
-        rows: &'a [AkagiRow],
-    }
-    let json = serde_json::to_string_pretty(&Report {
-        table: "akagi-t2",
-        machine: &machine,
-        date: &date,
-        command: &command,
-        rows: &out,
-    })?;
+    let json = serde_json::to_string_pretty(&Report { table: "akagi-t2", machine: env.machine, rows: &out })?;
+    let out_dir = env.out_dir;
     let (md_path, json_path, png_path) =
         (out_dir.join("akagi-t2.md"), out_dir.join("akagi-t2.json"), out_dir.join("akagi-t2.png"));
     write_atomic(&md_path, md.as_bytes())?;

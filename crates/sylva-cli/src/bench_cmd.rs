@@ -1,10 +1,15 @@
 //! `sylva bench`: the papers' result tables at their exact sizes, on the CPU and the GPU in
 //! one run, with the paper's figure beside ours, a Markdown table, a JSON file and a plot.
 //!
+//! Tables: `song-t2`, `song-t3` (here), `akagi-t2` ([`crate::bench_akagi`]), `zioma-t6-1`
+//! ([`crate::bench_zioma`]) and `skjermo` ([`crate::bench_skjermo`]).
+//!
 //! Timing: a warm-up, then repeated samples of several steps each (the count chosen so a
 //! sample takes about a fifth of the time budget); the median and the spread (min–max) of
-//! the samples are reported. GPU samples are wall clock from submission to completion, all
-//! of a sample's steps in one submission. Every row also states how close it runs to this
+//! the samples are reported. GPU samples are timed with timestamp queries where the adapter
+//! has them (the GPU's clock from the first pass of the sample to the end of the last,
+//! [`sylva_gpu::timer::GpuTimer`]), otherwise by wall clock from submission to completion;
+//! each rate says which (`clock`). Every row also states how close it runs to this
 //! machine's memory bandwidth, measured by the bench itself (a parallel copy on the CPU, a
 //! buffer copy on the GPU).
 
@@ -27,6 +32,11 @@ pub enum Table {
     SongT3,
     /// Akagi & Kitajima Table 2: mesh regeneration, 108,808…4,109,056 triangles.
     AkagiT2,
+    /// Zioma Table 6-1: 30…1,000 instances of an 80-branch tree, pose and skinning.
+    #[value(name = "zioma-t6-1")]
+    ZiomaT61,
+    /// Skjermo's figure: 65,535 and 262,143 branches updated per second.
+    Skjermo,
     /// Every table.
     All,
 }
@@ -78,6 +88,15 @@ pub struct Rate {
     pub samples: usize,
     /// Steps per sample.
     pub steps_per_sample: usize,
+    /// How the samples were timed: `wall clock` or `timestamp queries`.
+    pub clock: &'static str,
+}
+
+impl Rate {
+    /// Milliseconds per step: [median, fastest, slowest].
+    pub fn ms(&self) -> [f64; 3] {
+        [1e3 / self.median, 1e3 / self.max, 1e3 / self.min]
+    }
 }
 
 /// One row of a table.
@@ -120,6 +139,8 @@ pub struct Machine {
     pub cpu_bandwidth: f64,
     /// Measured GPU buffer-copy bandwidth (read + write), bytes/s.
     pub gpu_bandwidth: Option<f64>,
+    /// How GPU work is timed: `timestamp queries` or `wall clock`.
+    pub gpu_clock: Option<&'static str>,
     /// UTC time of the run.
     pub date: String,
     /// The command line.
@@ -139,17 +160,31 @@ pub struct Report {
     pub rows: Vec<Row>,
 }
 
+/// What every table's runner needs.
+pub(crate) struct Env<'a> {
+    /// Small sizes only.
+    pub quick: bool,
+    /// Time budget per measurement, s.
+    pub budget: f64,
+    /// Whether to time the CPU.
+    pub time_cpu: bool,
+    /// The GPU, when it is timed.
+    pub ctx: Option<&'static sylva_gpu::GpuContext>,
+    /// Where the files go.
+    pub out_dir: &'a Path,
+    /// The machine record.
+    pub machine: &'a Machine,
+}
+
 /// Runs `sylva bench` and returns the files written.
 pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
     let budget = args.budget.unwrap_or(if args.quick { 0.1 } else { 1.0 });
     if !(budget.is_finite() && budget > 0.0 && budget <= 600.0) {
         bail!("--budget {budget}: expected a time budget in seconds, above 0 and at most 600");
     }
-    let tables: &[Table] = match args.table {
-        Table::All => &[Table::SongT2, Table::SongT3, Table::AkagiT2],
-        Table::SongT2 => &[Table::SongT2],
-        Table::SongT3 => &[Table::SongT3],
-        Table::AkagiT2 => &[Table::AkagiT2],
+    let tables: Vec<Table> = match args.table {
+        Table::All => vec![Table::SongT2, Table::SongT3, Table::AkagiT2, Table::ZiomaT61, Table::Skjermo],
+        one => vec![one],
     };
     let ctx = match args.backend {
         Backends::Cpu => None,
@@ -167,6 +202,7 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
             Some(c) => Some(gpu_bandwidth(c)?),
             None => None,
         },
+        gpu_clock: ctx.map(|c| if c.timestamps { "timestamp queries" } else { "wall clock" }),
         date: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
         command: std::env::args().collect::<Vec<_>>().join(" "),
     };
@@ -176,22 +212,32 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
         machine.threads,
         machine.cpu_bandwidth / 1e9
     );
-    if let (Some(g), Some(b)) = (&machine.gpu, machine.gpu_bandwidth) {
-        println!("GPU: {g}, copy bandwidth {:.1} GB/s", b / 1e9);
+    if let (Some(g), Some(b), Some(clock)) = (&machine.gpu, machine.gpu_bandwidth, machine.gpu_clock) {
+        println!("GPU: {g}, copy bandwidth {:.1} GB/s, timed by {clock}", b / 1e9);
     }
+    let env = Env { quick: args.quick, budget, time_cpu, ctx, out_dir: &args.out_dir, machine: &machine };
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("creating {}", args.out_dir.display()))?;
     let wind = WindScene::resolve("gusty")?;
     let (fields, waves) = wind.pack();
     let params = HsmParams::song_tables();
     let mut written = Vec::new();
-    for &table in tables {
+    for table in tables {
         let (name, title, rows, copies) = match table {
             Table::SongT2 => ("song-t2", "Song et al. Table 2: one tree", &SONG_TABLE_2, 1),
             Table::SongT3 => ("song-t3", "Song et al. Table 3: ten trees", &SONG_TABLE_3, 10),
-            _ => {
-                written.extend(crate::bench_akagi::run(args.quick, budget, time_cpu, ctx, &args.out_dir)?);
+            Table::AkagiT2 => {
+                written.extend(crate::bench_akagi::run(&env)?);
                 continue;
             }
+            Table::ZiomaT61 => {
+                written.extend(crate::bench_zioma::run(&env)?);
+                continue;
+            }
+            Table::Skjermo => {
+                written.extend(crate::bench_skjermo::run(&env)?);
+                continue;
+            }
+            Table::All => unreachable!("expanded above"),
         };
         let rows = if args.quick { &rows[..3] } else { &rows[..] };
         let bar = ProgressBar::new(rows.len() as u64).with_style(
@@ -218,9 +264,8 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
             let gpu = match ctx {
                 Some(c) => {
                     let mut g = sylva_gpu::hsm::GpuHsm::new(c, None, &hsm, &wind)?;
-                    Some(measure(budget, |n| {
+                    Some(measure_gpu(budget, c, |n| {
                         g.advance(c, &hsm, dt, n);
-                        c.wait()?;
                         Ok(())
                     })?)
                 }
@@ -256,24 +301,62 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
     Ok(written)
 }
 
-/// Times `f(n)` (n steps): one warm-up call, a step count that makes a sample about a fifth
-/// of `budget`, then samples until the budget is spent (at least 3, at most 15).
+/// Times `f(n)` (n steps) by wall clock: one warm-up call, a step count that makes a sample
+/// about a fifth of `budget`, then samples until the budget is spent (at least 3, at most
+/// 15).
 pub(crate) fn measure(budget: f64, mut f: impl FnMut(usize) -> Result<()>) -> Result<Rate> {
-    let t0 = Instant::now();
-    f(1)?;
-    let one = t0.elapsed().as_secs_f64().max(1e-7);
-    // A second probe with more steps, now that caches and pipelines are warm.
-    let probe = ((budget / 20.0 / one) as usize).clamp(1, 100_000);
-    let t0 = Instant::now();
-    f(probe)?;
-    let per = (t0.elapsed().as_secs_f64() / probe as f64).max(1e-8);
-    let n = ((budget / 5.0 / per) as usize).clamp(1, 1_000_000);
-    let mut rates = Vec::new();
-    let start = Instant::now();
-    while rates.len() < 3 || (start.elapsed().as_secs_f64() < budget && rates.len() < 15) {
+    sample(budget, |n| {
         let t0 = Instant::now();
         f(n)?;
-        rates.push(n as f64 / t0.elapsed().as_secs_f64().max(1e-9));
+        Ok((t0.elapsed().as_secs_f64(), false))
+    })
+}
+
+/// Times GPU work as [`measure`] does; `f(n)` submits n steps (it need not wait). With
+/// timestamp queries a sample is the GPU's time from the first submission to the end of the
+/// last; without them, wall clock from the first submission to completion.
+pub(crate) fn measure_gpu(
+    budget: f64,
+    ctx: &sylva_gpu::GpuContext,
+    mut f: impl FnMut(usize) -> Result<()>,
+) -> Result<Rate> {
+    let timer = sylva_gpu::timer::GpuTimer::new(ctx);
+    sample(budget, |n| {
+        ctx.wait()?;
+        let t0 = Instant::now();
+        if let Some(t) = &timer {
+            t.start(ctx);
+        }
+        f(n)?;
+        let stamped = match &timer {
+            Some(t) => {
+                t.stop(ctx);
+                t.read(ctx)?
+            }
+            None => None,
+        };
+        ctx.wait()?;
+        Ok(match stamped {
+            Some(d) => (d.as_secs_f64(), true),
+            None => (t0.elapsed().as_secs_f64(), false),
+        })
+    })
+}
+
+/// The sampling loop: `f(n)` runs n steps and returns (seconds, timed by timestamps).
+fn sample(budget: f64, mut f: impl FnMut(usize) -> Result<(f64, bool)>) -> Result<Rate> {
+    let one = f(1)?.0.max(1e-7);
+    // A second probe with more steps, now that caches and pipelines are warm.
+    let probe = ((budget / 20.0 / one) as usize).clamp(1, 100_000);
+    let per = (f(probe)?.0 / probe as f64).max(1e-8);
+    let n = ((budget / 5.0 / per) as usize).clamp(1, 1_000_000);
+    let mut rates = Vec::new();
+    let mut stamped = true;
+    let start = Instant::now();
+    while rates.len() < 3 || (start.elapsed().as_secs_f64() < budget && rates.len() < 15) {
+        let (secs, s) = f(n)?;
+        stamped &= s;
+        rates.push(n as f64 / secs.max(1e-9));
     }
     rates.sort_by(f64::total_cmp);
     Ok(Rate {
@@ -282,6 +365,7 @@ pub(crate) fn measure(budget: f64, mut f: impl FnMut(usize) -> Result<()>) -> Re
         max: rates[rates.len() - 1],
         samples: rates.len(),
         steps_per_sample: n,
+        clock: if stamped { "timestamp queries" } else { "wall clock" },
     })
 }
 
@@ -337,7 +421,7 @@ pub(crate) fn gpu_bandwidth(ctx: &sylva_gpu::GpuContext) -> Result<f64> {
     Ok(2.0 * bytes as f64 / best.max(1e-9))
 }
 
-fn rate_cell(r: Option<Rate>) -> String {
+pub(crate) fn rate_cell(r: Option<Rate>) -> String {
     r.map_or("–".into(), |r| format!("{:.0} ({:.0}–{:.0})", r.median, r.min, r.max))
 }
 
@@ -360,9 +444,9 @@ fn row_line(r: &Row) -> String {
     )
 }
 
-fn markdown(rep: &Report) -> String {
-    let m = &rep.machine;
-    let mut s = format!("### {} ({})\n\n", rep.title, rep.table);
+/// The heading and machine paragraph every table's Markdown starts with.
+pub(crate) fn markdown_head(title: &str, table: &str, m: &Machine) -> String {
+    let mut s = format!("### {title} ({table})\n\n");
     s += &format!(
         "Machine: {} ({} threads of {} cores), CPU copy bandwidth {:.1} GB/s",
         m.cpu,
@@ -371,9 +455,15 @@ fn markdown(rep: &Report) -> String {
         m.cpu_bandwidth / 1e9
     );
     if let (Some(g), Some(b)) = (&m.gpu, m.gpu_bandwidth) {
-        s += &format!("; GPU {g}, copy bandwidth {:.1} GB/s", b / 1e9);
+        s +=
+            &format!("; GPU {g}, copy bandwidth {:.1} GB/s, timed by {}", b / 1e9, m.gpu_clock.unwrap_or("wall clock"));
     }
     s += &format!(".\nDate {}. Command `{}`.\n\n", m.date, m.command);
+    s
+}
+
+fn markdown(rep: &Report) -> String {
+    let mut s = markdown_head(&rep.title, &rep.table, &rep.machine);
     s += "| paper clusters | paper particles | paper steps/s (GTX 580) | clusters | particles | MB/step | CPU steps/s (median, min–max) | CPU / paper | CPU % of bandwidth | GPU steps/s | GPU / paper | GPU % of bandwidth | GPU / CPU |\n";
     s += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     for r in &rep.rows {

@@ -4,6 +4,8 @@
 
 mod bench_akagi;
 mod bench_cmd;
+mod bench_skjermo;
+mod bench_zioma;
 mod export_cmd;
 mod render_cmd;
 mod simulate_cmd;

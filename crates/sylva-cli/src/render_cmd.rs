@@ -201,6 +201,8 @@ impl Anim {
 struct ZiomaForest {
     method: Zioma,
     instances: Vec<ZiomaInstance>,
+    /// The instances' transforms for the renderer.
+    transforms: wgpu::Buffer,
     gpu: Option<sylva_gpu::pose::GpuZioma>,
     skin: GpuSkin,
     joint: wgpu::Buffer,
@@ -239,6 +241,7 @@ impl ZiomaForest {
             None
         };
         Ok(Self {
+            transforms: Renderer::instances(ctx, placements),
             skin: GpuSkin::new(ctx, layout, &SkinLayout::new(layout), instances.len() as u32)?,
             joint: sylva_gpu::kernel::output::<[f32; 4]>(ctx, "forest joints", n)?,
             acc: sylva_gpu::kernel::output::<[f32; 4]>(ctx, "forest rotations", n)?,
@@ -272,12 +275,44 @@ impl ZiomaForest {
     }
 }
 
+/// One simulation and its mesh, drawn at every instance dealt to it.
+struct Group {
+    anim: Anim,
+    mesh: GpuMesh,
+    /// Skjermo's bark from the deformer.
+    deform: Option<GpuDeform>,
+    instances: wgpu::Buffer,
+    count: u32,
+    /// Extra pre-roll steps: the group's phase offset in the wind.
+    lead_steps: usize,
+}
+
+impl Group {
+    #[allow(clippy::too_many_arguments)]
+    fn advance(
+        &mut self,
+        ctx: &GpuContext,
+        tree: &Tree,
+        wind: (&[RawField], &[RawWave]),
+        t: f32,
+        dt: f32,
+        steps: usize,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> Result<()> {
+        self.anim.advance_and_mesh(ctx, tree, wind, t, dt, steps, &self.mesh, encoder)?;
+        if let Some(d) = &self.deform {
+            self.anim.record_deform(ctx, encoder, d);
+        }
+        Ok(())
+    }
+}
+
 /// A tree of the scene as it is animated and drawn.
 enum Drawn {
-    /// One animated mesh, drawn once per instance; Skjermo's trees with the deformer's
-    /// bark.
-    Single(Box<(Anim, GpuMesh, Option<GpuDeform>)>),
-    /// Skinned instances, each with its own pose.
+    /// Independent simulations (phase groups), each with its own mesh drawn at its
+    /// instances.
+    Groups(Vec<Group>),
+    /// Zioma's copies: skinned instances, each with its own pose.
     Forest(Box<ZiomaForest>),
 }
 
@@ -429,12 +464,12 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
     struct Entry {
         tree: Tree,
         drawn: Drawn,
-        instances: wgpu::Buffer,
-        count: u32,
         label: String,
         base: Vec3,
     }
     impl Entry {
+        /// Advances every simulation `steps` steps (plus its phase lead when `preroll`).
+        #[allow(clippy::too_many_arguments)]
         fn advance(
             &mut self,
             ctx: &GpuContext,
@@ -442,14 +477,14 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
             t: f32,
             dt: f32,
             steps: usize,
+            preroll: bool,
             encoder: &mut wgpu::CommandEncoder,
         ) -> Result<()> {
             match &mut self.drawn {
-                Drawn::Single(single) => {
-                    let (anim, mesh, deform) = &mut **single;
-                    anim.advance_and_mesh(ctx, &self.tree, wind, t, dt, steps, mesh, encoder)?;
-                    if let Some(d) = deform {
-                        anim.record_deform(ctx, encoder, d);
+                Drawn::Groups(groups) => {
+                    for g in groups {
+                        let lead = if preroll { g.lead_steps } else { 0 };
+                        g.advance(ctx, &self.tree, wind, t, dt, steps + lead, encoder)?;
                     }
                     Ok(())
                 }
@@ -460,6 +495,8 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
             }
         }
     }
+    let steps = (o.sim_rate / o.fps).round().max(1.0) as usize;
+    let dt = 1.0 / (o.fps * steps as f32);
     let setup = Instant::now();
     let mut entries = Vec::new();
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
@@ -501,27 +538,42 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
             format!("{} · {} ({})", tree.name.replace('_', " "), st.method.as_str(), if gpu { "GPU" } else { "CPU" })
         });
         let mut bark_triangles = layout.tube_indices.len() / 3;
+        let groups = st.phase_groups();
         let drawn = if st.method == MethodName::Zioma && inst.len() > 1 {
             Drawn::Forest(Box::new(ZiomaForest::new(ctx, &tree, &layout, &inst, gpu, st.seed, &wind)?))
         } else {
-            let deform = if st.method == MethodName::Skjermo {
+            let grid = if st.method == MethodName::Skjermo {
                 let grid = DeformLayout::new(&tree, DeformerParams { sides: params.sides, ..Default::default() })?;
                 bark_triangles = grid.triangle_count();
-                let m = Skjermo::new(&tree, SkjermoParams::default());
-                Some(GpuDeform::new(ctx, &grid, &m.stems)?)
+                Some((grid, Skjermo::new(&tree, SkjermoParams::default())))
             } else {
                 None
             };
-            Drawn::Single(Box::new((
-                Anim::new(ctx, &tree, st.method, gpu, st.seed, &wind)?,
-                GpuMesh::new(ctx, &layout)?,
-                deform,
-            )))
+            let mut built = Vec::new();
+            for group in &groups {
+                let members: Vec<Instance> = group.members.iter().map(|&k| inst[k]).collect();
+                built.push(Group {
+                    anim: Anim::new(ctx, &tree, st.method, gpu, st.seed, &wind)?,
+                    mesh: GpuMesh::new(ctx, &layout)?,
+                    deform: match &grid {
+                        Some((grid, m)) => Some(GpuDeform::new(ctx, grid, &m.stems)?),
+                        None => None,
+                    },
+                    instances: Renderer::instances(ctx, &members),
+                    count: members.len() as u32,
+                    lead_steps: (group.offset_s / dt).round() as usize,
+                });
+            }
+            Drawn::Groups(built)
         };
         let tree_triangles = bark_triangles + layout.leaf_indices.len() / 3;
         triangles += tree_triangles * inst.len();
+        let simulations = match &drawn {
+            Drawn::Groups(g) if g.len() > 1 => format!(" in {} simulations", g.len()),
+            _ => String::new(),
+        };
         println!(
-            "  {:<18} {:>6} segments {:>7} leaves  {:>8} triangles × {} instance(s)  {}",
+            "  {:<18} {:>6} segments {:>7} leaves  {:>8} triangles × {} instance(s){simulations}  {}",
             tree.name,
             tree.segments.len(),
             tree.leaves.len(),
@@ -530,16 +582,8 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
             label
         );
         // Poses are in the tree's own frame (skinned instances sample the wind at their
-        // placement and turn it by their yaw); the instance transform places them.
-        let instances = Renderer::instances(ctx, &inst);
-        entries.push(Entry {
-            tree,
-            drawn,
-            instances,
-            count: inst.len() as u32,
-            label,
-            base: Vec3::from_array(st.position),
-        });
+        // placement and turn it by their yaw); the instance transforms place them.
+        entries.push(Entry { tree, drawn, label, base: Vec3::from_array(st.position) });
     }
     let renderer =
         Renderer::new(ctx, RenderSettings { width: o.width, height: o.height, msaa: o.msaa, ..Default::default() })?;
@@ -583,8 +627,6 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         std::fs::create_dir_all(&frames_dir).with_context(|| format!("creating {}", frames_dir.display()))?;
     }
     let frames = scene.frames();
-    let steps = (o.sim_rate / o.fps).round().max(1.0) as usize;
-    let dt = 1.0 / (o.fps * steps as f32);
     let gif_path = o.dir.join(format!("{}.gif", o.name));
     let gif_pending = o.gif.then(|| Pending::new(&gif_path));
     let mut gif = match &gif_pending {
@@ -614,13 +656,16 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
     };
 
     // Pre-roll: stateful methods start at rest; let the wind move them first.
+    // Phase groups pre-roll further, each by its own lead.
     let preroll_steps = (o.preroll * o.fps * steps as f32).round() as usize;
+    let leads = entries.iter().any(|e| matches!(&e.drawn, Drawn::Groups(g) if g.iter().any(|g| g.lead_steps > 0)));
+    let prerolled = preroll_steps > 0 || leads;
     let mut t = 0.0f32;
-    if preroll_steps > 0 {
+    if prerolled {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         t = preroll_steps as f32 * dt;
         for e in &mut entries {
-            e.advance(ctx, (&fields, &waves), t, dt, preroll_steps, &mut encoder)?;
+            e.advance(ctx, (&fields, &waves), t, dt, preroll_steps, true, &mut encoder)?;
         }
         ctx.queue.submit([encoder.finish()]);
     }
@@ -639,24 +684,26 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         }
         let t0 = Instant::now();
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let advance = if f == 0 && preroll_steps > 0 { 0 } else { steps };
+        let advance = if f == 0 && prerolled { 0 } else { steps };
         t += advance as f32 * dt;
         for e in &mut entries {
-            e.advance(ctx, (&fields, &waves), t, dt, advance, &mut encoder)?;
+            e.advance(ctx, (&fields, &waves), t, dt, advance, false, &mut encoder)?;
         }
         let t1 = Instant::now();
         let items: Vec<DrawItem<'_>> = entries
             .iter()
-            .map(|e| match &e.drawn {
-                Drawn::Single(single) => {
-                    let (_, mesh, deform) = &**single;
-                    let mut item = mesh.draw_item(&e.instances, e.count);
-                    if let Some(d) = deform {
-                        item.bark = d.bark();
-                    }
-                    item
-                }
-                Drawn::Forest(f) => f.skin.draw_item(&e.instances),
+            .flat_map(|e| match &e.drawn {
+                Drawn::Groups(groups) => groups
+                    .iter()
+                    .map(|g| {
+                        let mut item = g.mesh.draw_item(&g.instances, g.count);
+                        if let Some(d) = &g.deform {
+                            item.bark = d.bark();
+                        }
+                        item
+                    })
+                    .collect::<Vec<_>>(),
+                Drawn::Forest(f) => vec![f.skin.draw_item(&f.transforms)],
             })
             .collect();
         renderer.record(ctx, &mut encoder, &globals, &items);

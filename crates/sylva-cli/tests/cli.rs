@@ -73,6 +73,71 @@ species = "palm"
 method = "zioma"
 "#;
 
+/// Copies of a stateful-method tree get their own simulations (phase groups): with two
+/// groups the copy's pixels change and the tree's stay the same as with one shared
+/// simulation.
+#[test]
+fn render_copies_of_a_stateful_tree_sway_out_of_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |groups: u32| {
+        format!(
+            r#"
+[output]
+dir = "out{groups}"
+name = "pair"
+width = 192
+height = 96
+fps = 10
+seconds = 0.1
+preroll = 1
+sim_rate = 60
+mp4 = false
+gif = false
+labels = false
+
+[camera]
+eye = [0.0, 3.0, 14.0]
+target = [0.0, 3.0, 0.0]
+
+[sun]
+direction = [0.0, 1.0, 0.2]
+
+[[tree]]
+species = "palm"
+method = "akagi"
+backend = "cpu"
+position = [-6.0, 0.0, 0.0]
+copies = [{{ position = [6.0, 0.0, 0.0] }}]
+phase_groups = {groups}
+"#
+        )
+    };
+    let mut images = Vec::new();
+    for groups in [1, 2] {
+        let file = format!("pair{groups}.toml");
+        std::fs::write(dir.path().join(&file), scene(groups)).unwrap();
+        let (ok, out, err) = sylva(dir.path(), &["render", &file]);
+        assert!(ok, "{err}\n{out}");
+        assert_eq!(out.contains("in 2 simulations"), groups == 2, "{out}");
+        images.push(image::open(dir.path().join(format!("out{groups}/frames/pair_0000.png"))).unwrap().to_rgb8());
+    }
+    // Mean absolute difference over a band of columns.
+    let diff = |x0: u32, x1: u32| {
+        let mut sum = 0u64;
+        for y in 0..96 {
+            for x in x0..x1 {
+                let (a, b) = (images[0].get_pixel(x, y), images[1].get_pixel(x, y));
+                sum += (0..3).map(|c| a[c].abs_diff(b[c]) as u64).sum::<u64>();
+            }
+        }
+        sum as f64 / ((x1 - x0) * 96 * 3) as f64
+    };
+    let (tree, copy) = (diff(0, 80), diff(112, 192));
+    println!("mean |Δ|: tree {tree:.4}, copy {copy:.4}");
+    assert!(copy > 0.05, "the copy did not move differently: {copy}");
+    assert!(copy > 10.0 * tree, "tree {tree}, copy {copy}");
+}
+
 #[test]
 fn render_rejects_bad_scenes_naming_the_problem() {
     let dir = tempfile::tempdir().unwrap();
@@ -376,6 +441,50 @@ fn bench_quick_writes_complete_tables() {
     let md = std::fs::read_to_string(dir.path().join("b/akagi-t2.md")).unwrap();
     assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 2 + 3, "{md}");
     assert_eq!(&std::fs::read(dir.path().join("b/akagi-t2.png")).unwrap()[..4], b"\x89PNG");
+    // Zioma's Table 6-1: pose, frame and skinning-only timings for 30, 100 and 256 instances.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("b/zioma-t6-1.json")).unwrap()).unwrap();
+    assert_eq!(json["table"], "zioma-t6-1");
+    assert_eq!(json["machine"]["gpu_clock"].is_null(), !gpu);
+    let rows = json["rows"].as_array().unwrap();
+    assert_eq!(rows.iter().map(|r| r["instances"].as_u64().unwrap()).collect::<Vec<_>>(), [30, 100, 256]);
+    for r in rows {
+        assert_eq!(r["branches"].as_u64().unwrap(), 80 * r["instances"].as_u64().unwrap());
+        assert!(r["paper_dx10_ms"].as_f64().unwrap() > 0.0);
+        for key in ["cpu_pose_ms", "cpu_frame_ms", "cpu_skin_ms", "gpu_pose_ms", "gpu_frame_ms", "gpu_skin_ms"] {
+            if key.starts_with("gpu") && !gpu {
+                assert!(r[key].is_null(), "{key}");
+                continue;
+            }
+            let [m, lo, hi] = [0, 1, 2].map(|i| r[key][i].as_f64().unwrap());
+            assert!(lo <= m && m <= hi && m > 0.0, "{key}: {m} ({lo}–{hi})");
+        }
+        assert!(r["cpu_bandwidth_fraction"].as_f64().unwrap() > 0.0);
+    }
+    let md = std::fs::read_to_string(dir.path().join("b/zioma-t6-1.md")).unwrap();
+    assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 2 + 3, "{md}");
+    assert_eq!(&std::fs::read(dir.path().join("b/zioma-t6-1.png")).unwrap()[..4], b"\x89PNG");
+    // Skjermo's figure: the quick sizes are binary trees of 4,095 and 16,383 stems.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("b/skjermo.json")).unwrap()).unwrap();
+    assert_eq!(json["table"], "skjermo");
+    let rows = json["rows"].as_array().unwrap();
+    assert_eq!(rows.iter().map(|r| r["branches"].as_u64().unwrap()).collect::<Vec<_>>(), [4095, 16383]);
+    for r in rows {
+        assert!(r["paper_updates_per_s"].is_null(), "the quick sizes have no paper figure");
+        for key in ["cpu", "cpu_reference"] {
+            assert!(r[key]["median"].as_f64().unwrap() > 0.0, "{key}");
+            assert_eq!(r[key]["clock"], "wall clock");
+        }
+        assert_eq!(r["gpu"].is_null(), !gpu);
+        if gpu {
+            let clock = r["gpu"]["clock"].as_str().unwrap();
+            assert!(clock == "wall clock" || clock == "timestamp queries", "{clock}");
+        }
+    }
+    let md = std::fs::read_to_string(dir.path().join("b/skjermo.md")).unwrap();
+    assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 2 + 2, "{md}");
+    assert_eq!(&std::fs::read(dir.path().join("b/skjermo.png")).unwrap()[..4], b"\x89PNG");
     let leftovers: Vec<_> = std::fs::read_dir(dir.path().join("b"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())

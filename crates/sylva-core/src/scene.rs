@@ -18,6 +18,7 @@
 //! method = "zioma"               # zioma | akagi | skjermo | hsm
 //! position = [-9, 0, 0]
 //! copies = [{ position = [-30, 0, -40], yaw_deg = 40 }]
+//! phase_groups = 4               # akagi/skjermo/hsm: simulations the copies are dealt among
 //! ```
 //!
 //! Unknown keys, wrong types and out-of-range values are errors naming the file, line and
@@ -211,9 +212,62 @@ pub struct SceneTree {
     /// Sides of the leaf polygons (default 8).
     #[serde(default)]
     pub leaf_sides: Option<u32>,
-    /// More instances sharing this tree's animated mesh.
+    /// More instances of this tree. Zioma's copies each get their own pose (wind sampled at
+    /// the copy, its own phase and trunk seed, §6.5); the other methods' copies share
+    /// `phase_groups` simulations.
     #[serde(default)]
     pub copies: Vec<Copy>,
+    /// Independent simulations the instances of a stateful-method tree (akagi, skjermo,
+    /// hsm) are dealt among, round robin (1 to [`MAX_PHASE_GROUPS`], default 4). Each starts
+    /// at a different point of the wind ([`SceneTree::phase_groups`]), so copies in
+    /// different groups sway out of step; each costs a simulation and a mesh per frame.
+    #[serde(default = "default_phase_groups")]
+    pub phase_groups: u32,
+}
+
+fn default_phase_groups() -> u32 {
+    4
+}
+
+/// Most independent simulations per scene tree.
+pub const MAX_PHASE_GROUPS: u32 = 16;
+
+/// How far apart, in seconds of wind, phase groups start: offsets spread over this span.
+/// Longer than the gusts' correlation time of the presets (a few seconds), so groups do not
+/// move alike.
+pub const PHASE_SPAN_S: f32 = 8.0;
+
+/// Instances that share one simulation, and where in the wind it starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhaseGroup {
+    /// Extra pre-roll of this group's simulation, s (0 for the group holding the tree
+    /// itself): the group samples the wind this much later than the scene's clock.
+    pub offset_s: f32,
+    /// Instances: 0 is the tree itself, k ≥ 1 is `copies[k − 1]`.
+    pub members: Vec<usize>,
+}
+
+impl SceneTree {
+    /// The instances dealt among independent simulations. Zioma's pose is computed per
+    /// instance, so its instances form one group. For the stateful methods there are
+    /// `min(phase_groups, instances)` groups; instance k goes to group k mod groups, and
+    /// group g ≥ 1 starts `PHASE_SPAN_S · frac(g/φ + u)` seconds into the wind (φ the golden
+    /// ratio, u from the seed): offsets as evenly spread as a sequence can be, different
+    /// for every group.
+    pub fn phase_groups(&self) -> Vec<PhaseGroup> {
+        let instances = 1 + self.copies.len();
+        let groups = match self.method {
+            MethodName::Zioma => 1,
+            _ => (self.phase_groups.clamp(1, MAX_PHASE_GROUPS) as usize).min(instances),
+        };
+        let u = (crate::rng::mix64(self.seed ^ 0x5EED_F00D) >> 40) as f32 / (1u64 << 24) as f32;
+        (0..groups)
+            .map(|g| PhaseGroup {
+                offset_s: if g == 0 { 0.0 } else { PHASE_SPAN_S * (g as f32 * 0.618_034 + u).fract() },
+                members: (g..instances).step_by(groups).collect(),
+            })
+            .collect()
+    }
 }
 
 /// A scene.
@@ -396,6 +450,9 @@ impl Scene {
                         return err(&f(k), v.to_string(), "3 to 64 sides");
                     }
                 }
+            }
+            if !(1..=MAX_PHASE_GROUPS).contains(&t.phase_groups) {
+                return err(&f("phase_groups"), t.phase_groups.to_string(), "1 to 16 simulations");
             }
             for c in &t.copies {
                 if !(glam::Vec3::from_array(c.position).is_finite() && c.scale.is_finite() && c.scale > 0.0) {

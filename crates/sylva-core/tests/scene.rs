@@ -62,6 +62,10 @@ fn unknown_keys_and_bad_values_name_file_line_and_field() {
     let msg = Scene::from_toml(none, "s.toml", Path::new(".")).unwrap_err().to_string();
     assert!(msg.contains("tree"), "{msg}");
 
+    let groups = format!("{GOOD}phase_groups = 0\n");
+    let msg = Scene::from_toml(&groups, "s.toml", Path::new(".")).unwrap_err().to_string();
+    assert!(msg.contains("s.toml:12") && msg.contains("tree[0].phase_groups") && msg.contains("1 to 16"), "{msg}");
+
     let frames = GOOD.replace("seconds = 0.2", "seconds = 100000");
     let msg = Scene::from_toml(&frames, "s.toml", Path::new(".")).unwrap_err().to_string();
     assert!(msg.contains("output.seconds") && msg.contains("10,000 frames"), "{msg}");
@@ -88,4 +92,44 @@ fn relative_species_paths_resolve_against_the_scene_file() {
     let resolved = s.resolve_path(&s.trees[0].species);
     assert_eq!(Path::new(&resolved), dir.path().join("my_palm.toml"));
     SpeciesSource::resolve(&resolved).unwrap();
+}
+
+/// Copies of a stateful-method tree are dealt among independent simulations that start at
+/// different points of the wind; Zioma's copies stay one group (their phase is per instance).
+#[test]
+fn copies_are_dealt_among_phase_groups_with_distinct_offsets() {
+    let copies: String = (0..9).map(|k| format!("{{ position = [{}, 0, -20] }}", 5 * k)).collect::<Vec<_>>().join(", ");
+    let text = format!("{GOOD}copies = [{copies}]\n");
+    let s = Scene::from_toml(&text, "s.toml", Path::new(".")).unwrap();
+    let t = &s.trees[0];
+    assert_eq!(t.phase_groups, 4, "default");
+    let groups = t.phase_groups();
+    assert_eq!(groups.len(), 4);
+    assert_eq!(groups[0].offset_s, 0.0, "the tree itself keeps the scene's clock");
+    assert!(groups[0].members.contains(&0));
+    let mut seen: Vec<usize> = groups.iter().flat_map(|g| g.members.clone()).collect();
+    seen.sort();
+    assert_eq!(seen, (0..10).collect::<Vec<_>>(), "every instance in exactly one group");
+    let sizes: Vec<usize> = groups.iter().map(|g| g.members.len()).collect();
+    assert!(sizes.iter().max().unwrap() - sizes.iter().min().unwrap() <= 1, "{sizes:?}");
+    let mut offsets: Vec<f32> = groups.iter().map(|g| g.offset_s).collect();
+    assert!(offsets.iter().all(|&o| (0.0..sylva_core::scene::PHASE_SPAN_S).contains(&o)), "{offsets:?}");
+    offsets.sort_by(f32::total_cmp);
+    assert!(offsets.windows(2).all(|w| w[1] - w[0] > 0.5), "offsets too close: {offsets:?}");
+
+    // Fewer instances than groups: one simulation per instance.
+    let two = format!("{GOOD}copies = [{{ position = [5, 0, 0] }}]\n");
+    let s = Scene::from_toml(&two, "s.toml", Path::new(".")).unwrap();
+    assert_eq!(s.trees[0].phase_groups().len(), 2);
+    // One group asked for: every copy shares the tree's simulation.
+    let one = format!("{text}phase_groups = 1\n");
+    let s = Scene::from_toml(&one, "s.toml", Path::new(".")).unwrap();
+    assert_eq!(
+        s.trees[0].phase_groups(),
+        [sylva_core::scene::PhaseGroup { offset_s: 0.0, members: (0..10).collect() }]
+    );
+    // Zioma: one group whatever is asked.
+    let zioma = text.replace("\"akagi\"", "\"zioma\"");
+    let s = Scene::from_toml(&zioma, "s.toml", Path::new(".")).unwrap();
+    assert_eq!(s.trees[0].phase_groups().len(), 1);
 }

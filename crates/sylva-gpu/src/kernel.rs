@@ -79,17 +79,6 @@ impl Kernel {
         buffers: &[&wgpu::Buffer],
         invocations: u32,
     ) {
-        self.record_inner(ctx, encoder, buffers, invocations, None);
-    }
-
-    fn record_inner(
-        &self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        buffers: &[&wgpu::Buffer],
-        invocations: u32,
-        timestamps: Option<&wgpu::QuerySet>,
-    ) {
         let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
             .iter()
             .enumerate()
@@ -104,13 +93,8 @@ impl Kernel {
         let device_max = ctx.device.limits().max_compute_workgroups_per_dimension.max(1);
         let max = self.max_groups_x.map_or(device_max, |m| m.min(device_max));
         let (x, y) = if groups <= max { (groups, 1) } else { (max, groups.div_ceil(max)) };
-        let timestamp_writes = timestamps.map(|query_set| wgpu::ComputePassTimestampWrites {
-            query_set,
-            beginning_of_pass_write_index: Some(0),
-            end_of_pass_write_index: Some(1),
-        });
         let mut pass =
-            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes });
+            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(x, y, 1);
@@ -126,35 +110,21 @@ impl Kernel {
         invocations: u32,
     ) -> Result<KernelTiming, GpuError> {
         let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(self.name) });
-        let queries = ctx.timestamps.then(|| {
-            let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("kernel timing"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 2,
-            });
-            let resolve = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamps"),
-                size: 16,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            (set, resolve)
-        });
-        self.record_inner(ctx, &mut encoder, buffers, invocations, queries.as_ref().map(|q| &q.0));
-        if let Some((set, resolve)) = &queries {
-            encoder.resolve_query_set(set, 0..2, resolve, 0);
+        let timer = crate::timer::GpuTimer::new(ctx);
+        if let Some(t) = &timer {
+            t.begin(&mut encoder);
+        }
+        self.record(ctx, &mut encoder, buffers, invocations);
+        if let Some(t) = &timer {
+            t.end(&mut encoder);
         }
         ctx.wait()?;
         let start = std::time::Instant::now();
         ctx.queue.submit([encoder.finish()]);
         ctx.wait()?;
         let wall = start.elapsed();
-        let gpu = match &queries {
-            Some((_, resolve)) => {
-                let ts: Vec<u64> = read_back(ctx, resolve, 2)?;
-                let ns = ts[1].saturating_sub(ts[0]) as f64 * ctx.queue.get_timestamp_period() as f64;
-                (ns > 0.0).then(|| std::time::Duration::from_nanos(ns as u64))
-            }
+        let gpu = match &timer {
+            Some(t) => t.read(ctx)?,
             None => None,
         };
         Ok(KernelTiming { gpu, wall })

@@ -10,6 +10,7 @@
 //!   structure-of-arrays buffers, dispatch and read back.
 //! * [`shader`]: the WGSL sources; shared pieces (quaternions, the tree structs) are
 //!   composed into each kernel, never copied.
+//! * [`timer`]: GPU time of a stretch of work from timestamp queries.
 
 mod context;
 pub mod deform;
@@ -21,6 +22,7 @@ pub mod render;
 pub mod segment_ends;
 pub mod shader;
 pub mod skin;
+pub mod timer;
 pub mod trunk_noise;
 pub mod wind_sample;
 

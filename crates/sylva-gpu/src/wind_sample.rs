@@ -48,6 +48,14 @@ impl WindSampler {
         Ok(self.sample_timed(ctx, samples)?.0)
     }
 
+    /// Samples `count` points already on the GPU into a new buffer, submitted, not waited
+    /// for.
+    pub fn sample_into(&self, ctx: &GpuContext, input: &wgpu::Buffer, count: usize) -> wgpu::Buffer {
+        let out = output::<[f32; 4]>(ctx, "wind velocities", count).expect("the output is no larger than the input");
+        self.kernel.run(ctx, &[&self.fields, &self.waves, input, &out], count as u32);
+        out
+    }
+
     /// [`Self::sample`], with the kernel's timing (upload and readback excluded).
     pub fn sample_timed(
         &self,

@@ -179,3 +179,29 @@ fn kernel_timing_is_reported() {
     }
     println!("10k samples: {:?} (timestamps: {})", timing, ctx.timestamps);
 }
+
+/// The timer brackets work submitted between `start` and `stop`: the GPU time it reads is
+/// positive and no longer than the wall clock around the same submissions.
+#[test]
+fn gpu_timer_brackets_several_submissions() {
+    let Some(ctx) = common::gpu() else { return };
+    let Some(timer) = sylva_gpu::timer::GpuTimer::new(ctx) else {
+        assert!(!ctx.timestamps);
+        println!("skipping: the adapter has no timestamp queries");
+        return;
+    };
+    let scene = WindScene { fields: vec![WindField::Constant(Constant { direction: [1.0, 0.0, 0.0], speed: 3.0 })] };
+    let sampler = sylva_gpu::wind_sample::WindSampler::new(ctx, &scene).unwrap();
+    let input = sylva_gpu::kernel::upload(ctx, "timer samples", &samples(5)[..100_000]).unwrap();
+    ctx.wait().unwrap();
+    let wall = std::time::Instant::now();
+    timer.start(ctx);
+    for _ in 0..4 {
+        sampler.sample_into(ctx, &input, 100_000);
+    }
+    timer.stop(ctx);
+    let gpu = timer.read(ctx).unwrap().expect("timestamps advanced");
+    let wall = wall.elapsed();
+    println!("4 × 100k samples: GPU {gpu:?}, wall {wall:?}");
+    assert!(gpu > std::time::Duration::ZERO && gpu <= wall, "GPU {gpu:?}, wall {wall:?}");
+}

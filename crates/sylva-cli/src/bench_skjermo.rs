@@ -1,0 +1,193 @@
+//! `sylva bench skjermo`: Skjermo's results — the wind update of 65,536 and 262,144 branches
+//! per second (GeForce 7900 GTX: 600 and 180 updates/s).
+//!
+//! The trees are binary trees of one-segment stems (16 and 18 L-system iterations: 65,535
+//! and 262,143 stems). An update is the step the paper counts: every stem re-attaches to
+//! its parent's curve from the previous step, samples the wind and bends P2 and P3 (eqs.
+//! 15–17), the two state buffers ping-ponging; no pose, no mesh. The wind is the paper's
+//! setting, four sines (eqs. 11–14). CPU rows time the fast path (eight stems per lane
+//! group, rayon) and the reference kernel (one stem at a time, the WGSL's twin); GPU rows
+//! `skjermo.wgsl`, one dispatch per update. `--quick` times 4,095 and 16,383 branches
+//! instead (no paper figure).
+
+use crate::bench_akagi::Report;
+use crate::bench_cmd::{
+    Env, Rate, Series, markdown_head, measure, measure_gpu, plot_series, rate_cell as rate, write_atomic,
+};
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use plotters::style::RGBColor;
+use serde::Serialize;
+use std::path::PathBuf;
+use sylva_core::animate::skjermo::{RawSkjermoState, RawSkjermoStem, SKJERMO_FIGURE, Skjermo, SkjermoParams};
+use sylva_core::wind::WindScene;
+use sylva_core::{Grammar, LSystemOptions};
+
+/// A binary tree: every stem one segment, two children at ±30°.
+pub const BINARY: &str = "axiom: A(1)\nA(l) -> F(l)[+(30)A(l*0.8)][-(30)/(90)A(l*0.8)]\n";
+
+/// The paper's wind: four sines (eqs. 11–14).
+pub const FOUR_SINES: &str = "[[field]]\nkind = \"sum_of_sines\"\nsharpness = 2.0\nwaves = [\n\
+    { amplitude = 4.0, direction_deg = 0.0, wavelength = 40.0, speed = 6.0 },\n\
+    { amplitude = 2.0, direction_deg = 30.0, wavelength = 17.0, speed = 4.0 },\n\
+    { amplitude = 1.0, direction_deg = -25.0, wavelength = 9.0, speed = 3.0 },\n\
+    { amplitude = 0.5, direction_deg = 60.0, wavelength = 5.0, speed = 2.0 },\n]\n";
+
+/// One row.
+#[derive(Debug, Clone, Serialize)]
+pub struct SkjermoRow {
+    /// The paper's branches (`None` for the quick sizes).
+    pub paper_branches: Option<usize>,
+    /// The paper's updates per second.
+    pub paper_updates_per_s: Option<f64>,
+    /// Our branches (stems).
+    pub branches: usize,
+    /// Bytes read and written per update (stem constants and state in, state out).
+    pub bytes_per_update: usize,
+    /// CPU fast path, updates/s.
+    pub cpu: Option<Rate>,
+    /// CPU reference kernel, updates/s.
+    pub cpu_reference: Option<Rate>,
+    /// GPU, updates/s.
+    pub gpu: Option<Rate>,
+    /// CPU bytes/s over the measured copy bandwidth.
+    pub cpu_bandwidth_fraction: Option<f64>,
+    /// GPU bytes/s over the measured copy bandwidth.
+    pub gpu_bandwidth_fraction: Option<f64>,
+}
+
+/// Runs the table; returns the files written.
+pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
+    let sizes: Vec<(u32, Option<(usize, f64)>)> = if env.quick {
+        vec![(12, None), (14, None)]
+    } else {
+        vec![(16, Some(SKJERMO_FIGURE[0])), (18, Some(SKJERMO_FIGURE[1]))]
+    };
+    let wind = WindScene::from_toml(FOUR_SINES, "four sines")?;
+    let (fields, waves) = wind.pack();
+    let grammar = Grammar::parse(BINARY, "binary.lsys")?;
+    let bar = ProgressBar::new(sizes.len() as u64).with_style(
+        ProgressStyle::with_template("{msg:>10} [{bar:30}] {pos}/{len} rows, {elapsed}").expect("valid template"),
+    );
+    bar.set_message("skjermo");
+    let dt = 1.0 / 60.0;
+    let mut out = Vec::new();
+    for (iterations, paper) in sizes {
+        let tree = grammar.generate(&LSystemOptions { seed: 1, iterations: Some(iterations), ..Default::default() })?;
+        let m = Skjermo::new(&tree, SkjermoParams::default());
+        let n = tree.stems.len();
+        // Per stem: its constants and its and its parent's previous state read, its next
+        // state written.
+        let bytes = n * (std::mem::size_of::<RawSkjermoStem>() + 3 * std::mem::size_of::<RawSkjermoState>());
+        let (cpu, cpu_reference) = if env.time_cpu {
+            let mut state = m.rest_state(&tree);
+            let fast = measure(env.budget, |k| {
+                for _ in 0..k {
+                    m.step_stems(&fields, &waves, &mut state, dt);
+                }
+                Ok(())
+            })?;
+            let mut state = m.rest_state(&tree);
+            let reference = measure(env.budget, |k| {
+                for _ in 0..k {
+                    m.step_reference(&fields, &waves, &mut state, dt);
+                }
+                Ok(())
+            })?;
+            (Some(fast), Some(reference))
+        } else {
+            (None, None)
+        };
+        let gpu = match env.ctx {
+            Some(c) => {
+                let mut g = sylva_gpu::pose::GpuSkjermo::new(c, &tree, &m, &wind)?;
+                Some(measure_gpu(env.budget, c, |k| {
+                    for _ in 0..k {
+                        g.step_only(c, dt);
+                    }
+                    Ok(())
+                })?)
+            }
+            None => None,
+        };
+        let row = SkjermoRow {
+            paper_branches: paper.map(|p| p.0),
+            paper_updates_per_s: paper.map(|p| p.1),
+            branches: n,
+            bytes_per_update: bytes,
+            cpu_bandwidth_fraction: cpu.map(|r| r.median * bytes as f64 / env.machine.cpu_bandwidth),
+            gpu_bandwidth_fraction: gpu.zip(env.machine.gpu_bandwidth).map(|(r, b)| r.median * bytes as f64 / b),
+            cpu,
+            cpu_reference,
+            gpu,
+        };
+        bar.suspend(|| {
+            println!(
+                "{:>7} branches: CPU {} updates/s (reference kernel {}), GPU {} updates/s{}",
+                row.branches,
+                rate(row.cpu),
+                rate(row.cpu_reference),
+                rate(row.gpu),
+                row.paper_updates_per_s.map_or(String::new(), |p| format!(" (paper {p:.0})"))
+            )
+        });
+        out.push(row);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    let mut md = markdown_head("Skjermo: branches updated per second", "skjermo", env.machine);
+    md += "Updates per second, median (slowest–fastest). Wind: four sines (the paper's setting). The paper: \
+           GeForce 7900 GTX, the wind animation shader alone.\n\n";
+    md += "| paper branches | paper updates/s | branches | MB/update | CPU updates/s | CPU reference kernel | CPU / paper | CPU % of bandwidth | GPU updates/s | GPU / paper | GPU % of bandwidth | GPU / CPU |\n";
+    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    let over = |r: Option<Rate>, p: Option<f64>| match (r, p) {
+        (Some(r), Some(p)) => format!("{:.2}", r.median / p),
+        _ => "–".into(),
+    };
+    let pct = |f: Option<f64>| f.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f));
+    for r in &out {
+        md += &format!(
+            "| {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            r.paper_branches.map_or("–".into(), |b| b.to_string()),
+            r.paper_updates_per_s.map_or("–".into(), |p| format!("{p:.0}")),
+            r.branches,
+            r.bytes_per_update as f64 / 1e6,
+            rate(r.cpu),
+            rate(r.cpu_reference),
+            over(r.cpu, r.paper_updates_per_s),
+            pct(r.cpu_bandwidth_fraction),
+            rate(r.gpu),
+            over(r.gpu, r.paper_updates_per_s),
+            pct(r.gpu_bandwidth_fraction),
+            match (r.gpu, r.cpu) {
+                (Some(g), Some(c)) => format!("{:.2}", g.median / c.median),
+                _ => "–".into(),
+            },
+        );
+    }
+    let json = serde_json::to_string_pretty(&Report { table: "skjermo", machine: env.machine, rows: &out })?;
+    let (md_path, json_path, png_path) =
+        (env.out_dir.join("skjermo.md"), env.out_dir.join("skjermo.json"), env.out_dir.join("skjermo.png"));
+    write_atomic(&md_path, md.as_bytes())?;
+    write_atomic(&json_path, json.as_bytes())?;
+    let pick = |f: fn(&SkjermoRow) -> Option<Rate>| -> Vec<(f64, f64)> {
+        out.iter().filter_map(|r| f(r).map(|y| (r.branches as f64, y.median))).collect()
+    };
+    let series: Vec<Series> = vec![
+        (
+            "paper (7900 GTX)",
+            RGBColor(120, 120, 120),
+            out.iter()
+                .filter_map(|r| r.paper_branches.zip(r.paper_updates_per_s).map(|(b, p)| (b as f64, p)))
+                .collect(),
+        ),
+        ("CPU", RGBColor(200, 60, 40), pick(|r| r.cpu)),
+        ("CPU reference kernel", RGBColor(230, 140, 60), pick(|r| r.cpu_reference)),
+        ("GPU", RGBColor(40, 90, 200), pick(|r| r.gpu)),
+    ];
+    plot_series("Skjermo — branches updated per second", "branches", "updates per second", series, &png_path)
+        .context("plotting skjermo")?;
+    println!("{md}");
+    Ok(vec![md_path, json_path, png_path])
+}
