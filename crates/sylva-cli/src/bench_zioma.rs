@@ -62,8 +62,8 @@ pub struct ZiomaRow {
     pub gpu_skin_ms: Option<[f64; 3]>,
     /// How the GPU was timed.
     pub gpu_clock: Option<&'static str>,
-    /// Why the GPU skinning columns are empty, when they are (the skinned vertices of
-    /// every instance exceed the device's largest storage binding).
+    /// Why the GPU skinning columns are empty, when they are (one instance's skinned
+    /// vertices exceed the device's largest storage binding; more instances are batched).
     pub gpu_skin_skipped: Option<String>,
     /// CPU frame bytes/s over the measured copy bandwidth.
     pub cpu_bandwidth_fraction: Option<f64>,

@@ -703,7 +703,7 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
                         item
                     })
                     .collect::<Vec<_>>(),
-                Drawn::Forest(f) => vec![f.skin.draw_item(&f.transforms)],
+                Drawn::Forest(f) => f.skin.draw_items(&f.transforms),
             })
             .collect();
         renderer.record(ctx, &mut encoder, &globals, &items);

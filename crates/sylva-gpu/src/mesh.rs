@@ -167,6 +167,7 @@ impl GpuMesh {
             bark: buffers(&self.tube_vertices, &self.tube_indices, self.tube_index_count),
             leaves: buffers(&self.leaf_vertices, &self.leaf_indices, self.leaf_index_count),
             instances,
+            first_instance: 0,
             instance_count,
         }
     }

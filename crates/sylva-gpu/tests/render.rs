@@ -107,3 +107,52 @@ fn small_scene_matches_its_golden_image() {
     assert!(px(2, h - 2)[1] > px(2, h - 2)[2], "ground is not green: {:?}", px(2, h - 2));
     check_golden("small_scene", w, h, &rgba);
 }
+
+/// Skinned instances drawn in batches (the split that keeps a large forest under the binding
+/// limit) give the same image as one batch: every instance is drawn once, with its own
+/// transform and its own pose.
+#[test]
+fn skinned_instances_drawn_in_batches_match_one_batch() {
+    use sylva_core::mesh::SkinLayout;
+    use sylva_gpu::skin::GpuSkin;
+    let Some(ctx) = common::gpu() else { return };
+    let t = SpeciesSource::resolve("palm").unwrap().generate(1, &Default::default(), None).unwrap();
+    let layout = MeshLayout::new(&t, MeshParams { sides: 6, leaf_sides: 6, ..Default::default() }).unwrap();
+    let skin = SkinLayout::new(&layout);
+    let (w, h) = (160u32, 96u32);
+    let renderer = Renderer::new(ctx, RenderSettings { width: w, height: h, msaa: 1, shadow_size: 256 }).unwrap();
+    let camera = Camera { eye: Vec3::new(0.0, 3.0, 14.0), target: Vec3::new(0.0, 2.5, 0.0), fov_y_deg: 45.0 };
+    let tint = Vec3::new(0.25, 0.5, 0.1);
+    let placed: Vec<Instance> = (0..3)
+        .map(|k| Instance { transform: Mat4::from_translation(Vec3::new(-5.0 + 5.0 * k as f32, 0.0, 0.0)), tint })
+        .collect();
+    let instances = Renderer::instances(ctx, &placed);
+    let globals =
+        renderer.globals(&camera, &Lighting::default(), (Vec3::new(-8.0, 0.0, -3.0), Vec3::new(8.0, 6.0, 3.0)));
+    // Each instance its own pose: the crown bent by a different angle.
+    let (mut joint, mut acc) = (Vec::new(), Vec::new());
+    for k in 0..3 {
+        let bend = glam::Quat::from_rotation_z(0.15 * k as f32);
+        let delta: Vec<[f32; 4]> = (0..t.segments.len())
+            .map(|s| if t.segments.parent[s] == sylva_core::NONE { bend.to_array() } else { [0.0, 0.0, 0.0, 1.0] })
+            .collect();
+        let (j, a) = sylva_core::animate::seam_buffers(&t, &delta);
+        joint.extend(j);
+        acc.extend(a);
+    }
+    let jb = sylva_gpu::kernel::upload(ctx, "joints", &joint).unwrap();
+    let ab = sylva_gpu::kernel::upload(ctx, "rotations", &acc).unwrap();
+    let mut images = Vec::new();
+    for max_batch in [u32::MAX, 1] {
+        let g = GpuSkin::with_max_batch(ctx, &layout, &skin, 3, max_batch).unwrap();
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        g.record(ctx, &mut encoder, &jb, &ab);
+        renderer.record(ctx, &mut encoder, &globals, &g.draw_items(&instances));
+        images.push(renderer.read_image(ctx, encoder).unwrap());
+    }
+    let empty = renderer.render(ctx, &globals, &[]).unwrap();
+    let trees = images[0].chunks(4).zip(empty.chunks(4)).filter(|(a, b)| a[..3] != b[..3]).count();
+    assert!(trees > (w * h / 50) as usize, "only {trees} pixels show trees");
+    let differ = images[0].chunks(4).zip(images[1].chunks(4)).filter(|(a, b)| a[..3] != b[..3]).count();
+    assert_eq!(differ, 0, "{differ} pixels differ between one batch and three");
+}

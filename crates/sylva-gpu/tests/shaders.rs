@@ -431,7 +431,7 @@ fn skin_structs_match_their_wgsl_twins() {
             ("vertices", offset_of!(RawSkinInfo, vertices)),
             ("segments", offset_of!(RawSkinInfo, segments)),
             ("instances", offset_of!(RawSkinInfo, instances)),
-            ("_pad", offset_of!(RawSkinInfo, _pad)),
+            ("first_instance", offset_of!(RawSkinInfo, first_instance)),
         ],
     );
 }

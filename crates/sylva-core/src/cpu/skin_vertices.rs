@@ -13,7 +13,8 @@ fn bone(rest_joint: &[[f32; 4]], joint: &[[f32; 4]], acc: &[[f32; 4]], base: usi
     (Vec3::new(j[0], j[1], j[2]), Quat::from_array(acc[base + b]), Vec3::new(r[0], r[1], r[2]))
 }
 
-/// Writes `out[instance × vertices + v]`. Bindings as in the kernel: 0 info, 1 rest, 2 skin,
+/// Writes `out[instance × vertices + v]` for the dispatch's instances, reading pose
+/// `first_instance + instance`. Bindings as in the kernel: 0 info, 1 rest, 2 skin,
 /// 3 rest joints (one instance), 4 joints, 5 rotations (instance-major), 6 out (write).
 pub fn skin_vertices(
     info: &RawSkinInfo,
@@ -27,7 +28,7 @@ pub fn skin_vertices(
     let n = info.vertices as usize;
     out.par_iter_mut().enumerate().for_each(|(id, o)| {
         let (inst, v) = (id / n, id % n);
-        let base = inst * info.segments as usize;
+        let base = (info.first_instance as usize + inst) * info.segments as usize;
         let (x, nrm) = (Vec3::from_array(rest[v].position), Vec3::from_array(rest[v].normal));
         let s = skin[v];
         let (j0, d0, r0) = bone(rest_joint, joint, acc, base, s.bone0 as usize);

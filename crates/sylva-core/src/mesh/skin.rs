@@ -39,10 +39,11 @@ pub struct RawSkinInfo {
     pub vertices: u32,
     /// Segments of one instance (the pose stride).
     pub segments: u32,
-    /// Instances.
+    /// Instances skinned by this dispatch.
     pub instances: u32,
-    /// Padding.
-    pub _pad: u32,
+    /// The first of them: instance `k` of the dispatch reads pose `first_instance + k` and
+    /// writes `out[k × vertices ..]` (batches keep each output under the binding limit).
+    pub first_instance: u32,
 }
 
 /// A rest mesh with its bone weights, bark and leaves in separate ranges (as
@@ -109,7 +110,8 @@ impl SkinLayout {
     /// leaves, instance-major.
     pub fn skin(&self, joint: &[[f32; 4]], acc: &[[f32; 4]], instances: u32) -> super::MeshFrame {
         let run = |rest: &[RawVertex], skin: &[RawSkin]| {
-            let info = RawSkinInfo { vertices: rest.len() as u32, segments: self.segments, instances, _pad: 0 };
+            let info =
+                RawSkinInfo { vertices: rest.len() as u32, segments: self.segments, instances, first_instance: 0 };
             let mut out = vec![RawVertex::zeroed(); rest.len() * instances as usize];
             crate::cpu::skin_vertices(&info, rest, skin, &self.rest_joint, joint, acc, &mut out);
             out

@@ -166,6 +166,8 @@ pub struct DrawItem<'a> {
     pub leaves: MeshBuffers<'a>,
     /// Instance transforms (from [`Renderer::instances`]).
     pub instances: &'a wgpu::Buffer,
+    /// The first transform of `instances` this item draws.
+    pub first_instance: u32,
     /// How many.
     pub instance_count: u32,
 }
@@ -524,12 +526,13 @@ impl Renderer {
                 pass.set_vertex_buffer(0, m.vertices.slice(..));
                 pass.set_vertex_buffer(1, item.instances.slice(..));
                 pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
+                let first = item.first_instance;
                 if m.per_instance_vertices == 0 {
-                    pass.draw_indexed(0..m.index_count, 0, 0..item.instance_count);
+                    pass.draw_indexed(0..m.index_count, 0, first..first + item.instance_count);
                 } else {
                     for k in 0..item.instance_count {
                         let base = (k * m.per_instance_vertices) as i32;
-                        pass.draw_indexed(0..m.index_count, base, k..k + 1);
+                        pass.draw_indexed(0..m.index_count, base, first + k..first + k + 1);
                     }
                 }
             }

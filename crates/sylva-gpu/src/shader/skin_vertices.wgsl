@@ -1,5 +1,5 @@
 // skin_vertices: linear blend skinning with two bones (Zioma §6.5), one output vertex per
-// invocation, instance-major: out[instance * vertices + v].
+// invocation, instance-major: out[instance * vertices + v], reading pose first_instance + instance.
 // CPU twin: sylva_core::cpu::skin_vertices (same bindings, same loop body).
 
 struct Skin {
@@ -13,7 +13,7 @@ struct SkinInfo {
     vertices: u32,
     segments: u32,
     instances: u32,
-    _pad: u32,
+    first_instance: u32,
 }
 
 @group(0) @binding(0) var<storage, read> info: SkinInfo;
@@ -32,7 +32,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let inst = id / info.vertices;
     let v = id % info.vertices;
-    let base = inst * info.segments;
+    let base = (info.first_instance + inst) * info.segments;
     let x = rest[v].position;
     let nrm = rest[v].normal;
     let s = skin[v];
