@@ -8,7 +8,11 @@ mod bench_skjermo;
 mod bench_zioma;
 mod export_cmd;
 mod render_cmd;
+mod scene_runtime;
 mod simulate_cmd;
+#[cfg(feature = "viewer")]
+mod view_app;
+mod view_cmd;
 mod wind_cmd;
 
 use anyhow::{Context, Result};
@@ -45,6 +49,9 @@ enum Command {
     /// Export a tree as glTF 2.0 (.glb/.gltf): mesh, materials, a skin and wind baked from
     /// any method (optionally looping), hierarchy attributes for engine wind shaders, LODs.
     Export(export_cmd::ExportArgs),
+    /// Open the interactive viewer: the scene in a window, with wind, trees and methods
+    /// under the user's control (blasts and vortices by clicking the ground).
+    View(view_cmd::ViewArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -87,6 +94,7 @@ fn main() -> Result<()> {
         }
         Some(Command::Simulate(args)) => simulate_cmd::run(&args),
         Some(Command::Export(args)) => export_cmd::run(&args).map(|_| ()),
+        Some(Command::View(args)) => view_cmd::run(&args),
         Some(Command::Bench(args)) => {
             for p in bench_cmd::run(&args)? {
                 println!("wrote {}", p.display());

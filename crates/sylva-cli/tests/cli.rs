@@ -613,3 +613,140 @@ fn mp4_pipe_hands_ffmpeg_every_frame_and_renames_when_done() {
         .collect();
     assert!(tmp.is_empty(), "{tmp:?}");
 }
+
+/// A virtual X display (Xvfb) for the viewer's tests, stopped when dropped. `None` (with
+/// the reason printed) when Xvfb is not installed, except in CI, where that fails.
+struct Xvfb {
+    child: std::process::Child,
+    display: String,
+}
+
+impl Xvfb {
+    fn start() -> Option<Self> {
+        use std::io::BufRead;
+        let spawned = Command::new("Xvfb")
+            .args(["-displayfd", "1", "-screen", "0", "1024x768x24", "-nolisten", "tcp"])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::null())
+            .spawn();
+        let mut child = match spawned {
+            Ok(c) => c,
+            Err(e) => {
+                assert!(std::env::var("CI").is_err(), "CI requires Xvfb for the viewer tests: {e}");
+                eprintln!("skipping: Xvfb is not installed ({e})");
+                return None;
+            }
+        };
+        let mut line = String::new();
+        std::io::BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
+        let n: u32 = line.trim().parse().unwrap_or_else(|_| panic!("Xvfb printed no display number: {line:?}"));
+        Some(Self { child, display: format!(":{n}") })
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+const VIEW_SCENE: &str = r#"
+wind = "calm.toml"
+[output]
+fps = 30
+sim_rate = 60
+[camera]
+eye = [0.0, 3.0, 12.0]
+target = [0.0, 3.0, 0.0]
+[[tree]]
+species = "palm"
+method = "akagi"
+backend = "cpu"
+"#;
+
+/// The viewer under Xvfb, driven by a script: the frame shows the tree, a blast placed by
+/// clicking the ground moves it, a malformed scene on disk shows its error and keeps the
+/// last good scene running, and a good edit is picked up.
+#[test]
+fn viewer_runs_a_scripted_session_under_xvfb() {
+    let Some(x) = Xvfb::start() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.toml"), VIEW_SCENE).unwrap();
+    std::fs::write(dir.path().join("calm.toml"), "# still air\n").unwrap();
+    std::fs::write(dir.path().join("broken.toml"), VIEW_SCENE.replace("fps = 30", "fps = 30\nfsp = 2")).unwrap();
+    let two = format!("{VIEW_SCENE}\n[[tree]]\nspecies = \"palm\"\nmethod = \"zioma\"\nposition = [4.0, 0.0, -3.0]\n");
+    std::fs::write(dir.path().join("two.toml"), two).unwrap();
+    std::fs::write(
+        dir.path().join("script.txt"),
+        "frames 5\nreport before.json\nclick 0.55 0.9   # the ground in front of the palm\nframes 30\n\
+         report after.json\nscreenshot shot.png\noverwrite-scene broken.toml\nframes 3\nreport broken.json\n\
+         overwrite-scene two.toml\nframes 3\nreport two.json\nquit\n",
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .current_dir(dir.path())
+        .env("DISPLAY", &x.display)
+        .env_remove("WAYLAND_DISPLAY")
+        .args(["view", "scene.toml", "--script", "script.txt", "--width", "640", "--height", "400"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}\n{}", String::from_utf8_lossy(&out.stdout));
+    let report = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join(name)).unwrap()).unwrap()
+    };
+    let displacement = |r: &serde_json::Value| r["trees"][0]["displacement_m"].as_f64().unwrap();
+    let (before, after) = (report("before.json"), report("after.json"));
+    assert_eq!(displacement(&before), 0.0, "still air leaves the tree at rest");
+    assert!(displacement(&after) > 1e-3, "the blast did not move the tree: {after}");
+    assert_eq!(after["effects"], 1);
+    assert!(after["frames"].as_u64().unwrap() > before["frames"].as_u64().unwrap());
+
+    // The tree is in the frame: where the crown stands against the sky, pixels differ from
+    // the sky at the same height at the image's edge.
+    let shot = image::open(dir.path().join("shot.png")).unwrap().to_rgb8();
+    let (w, h) = shot.dimensions();
+    assert!(w > 100 && h > 100, "{w}×{h}");
+    let mut crown = 0;
+    for y in h / 8..h / 2 {
+        let edge = shot.get_pixel(1, y);
+        for x in w * 3 / 8..w * 5 / 8 {
+            let p = shot.get_pixel(x, y);
+            if (0..3).map(|c| p[c].abs_diff(edge[c]) as u32).sum::<u32>() > 40 {
+                crown += 1;
+            }
+        }
+    }
+    assert!(crown > (w * h / 200) as usize, "only {crown} tree pixels against the sky");
+
+    // A malformed scene: the error names the file, line and key; the old scene runs on.
+    let broken = report("broken.json");
+    let msg = broken["reload_error"].as_str().unwrap_or_else(|| panic!("no reload error: {broken}"));
+    assert!(msg.contains("scene.toml") && msg.contains("fsp"), "{msg}");
+    assert_eq!(broken["trees"].as_array().unwrap().len(), 1);
+    assert!(broken["frames"].as_u64().unwrap() > after["frames"].as_u64().unwrap());
+    // A good edit replaces it.
+    let two = report("two.json");
+    assert!(two["reload_error"].is_null(), "{two}");
+    assert_eq!(two["trees"].as_array().unwrap().len(), 2);
+}
+
+#[test]
+fn viewer_without_a_display_says_so_and_points_to_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .current_dir(dir.path())
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .args(["view"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("no display") && err.contains("sylva render"), "{err}");
+    // A bad script is reported before any window opens.
+    std::fs::write(dir.path().join("s.txt"), "frames 2\nteleport 3\n").unwrap();
+    let (ok, _, err) = sylva(dir.path(), &["view", "--script", "s.txt"]);
+    assert!(!ok && err.contains("s.txt:2") && err.contains("teleport"), "{err}");
+}

@@ -25,11 +25,11 @@
 //! field.
 
 use crate::species::{field_line, line_col};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// An animation method by name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum MethodName {
     /// Zioma, GPU Gems 3 ch. 6 (procedural, stateless).
@@ -55,7 +55,7 @@ impl MethodName {
 }
 
 /// Where the simulation runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum BackendChoice {
     /// GPU on a hardware adapter, CPU on a software rasteriser (where the CPU path is
@@ -69,7 +69,7 @@ pub enum BackendChoice {
 }
 
 /// Image and animation output.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Output {
     /// Directory for the animation and frames (relative to the working directory).
@@ -121,7 +121,7 @@ impl Default for Output {
 }
 
 /// The camera.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CameraSettings {
     /// Eye position, m.
@@ -139,7 +139,7 @@ impl Default for CameraSettings {
 }
 
 /// The sun.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Sun {
     /// Direction towards the sun (normalised on use).
@@ -155,7 +155,7 @@ impl Default for Sun {
 }
 
 /// An extra instance of a tree: drawn by instancing with the same animated mesh.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Copy {
     /// Position, m.
@@ -177,7 +177,7 @@ fn default_seed() -> u64 {
 }
 
 /// One tree of the scene.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneTree {
     /// A preset name, a Weber–Penn TOML or an L-system grammar (paths relative to the scene
@@ -271,7 +271,7 @@ impl SceneTree {
 }
 
 /// A scene.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
     /// Wind preset or file.
@@ -331,6 +331,12 @@ impl Scene {
     pub fn default_scene() -> Self {
         Self::from_toml(DEFAULT_SCENE, "presets/scenes/default.toml", Path::new("."))
             .expect("the default scene is valid")
+    }
+
+    /// The scene as TOML text that [`Scene::from_toml`] reads back to an equal scene (a
+    /// viewer's "save").
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).expect("a scene is always representable in TOML")
     }
 
     /// Reads a scene file (at most 1 MiB).

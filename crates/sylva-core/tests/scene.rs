@@ -133,3 +133,12 @@ fn copies_are_dealt_among_phase_groups_with_distinct_offsets() {
     let s = Scene::from_toml(&zioma, "s.toml", Path::new(".")).unwrap();
     assert_eq!(s.trees[0].phase_groups().len(), 1);
 }
+
+/// Saving a scene (the viewer's "save") writes TOML that reads back to the same scene.
+#[test]
+fn a_scene_saved_as_toml_reads_back_equal() {
+    let s = Scene::default_scene();
+    let text = s.to_toml();
+    let back = Scene::from_toml(&text, &s.file, Path::new(".")).unwrap();
+    assert_eq!(back, s, "{text}");
+}

@@ -55,6 +55,8 @@ impl std::fmt::Display for AdapterSummary {
 /// A device and its queue, with the adapter it came from.
 #[derive(Debug)]
 pub struct GpuContext {
+    /// The instance (a window's surface must come from it).
+    pub instance: wgpu::Instance,
     /// The adapter.
     pub adapter: wgpu::Adapter,
     /// The device.
@@ -109,7 +111,7 @@ impl GpuContext {
             trace: wgpu::Trace::Off,
         }))
         .map_err(|e| GpuError::Device { adapter: summary.name.clone(), message: e.to_string() })?;
-        Ok(Self { adapter, device, queue, summary, timestamps, kernels: Default::default() })
+        Ok(Self { instance, adapter, device, queue, summary, timestamps, kernels: Default::default() })
     }
 
     /// One context shared by the whole process (tests, benchmarks, the CLI): created on

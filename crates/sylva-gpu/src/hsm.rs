@@ -61,6 +61,13 @@ pub struct GpuHsm {
 pub const MAX_SUBSTEPS_PER_SUBMISSION: usize = 4096;
 
 impl GpuHsm {
+    /// Replaces the wind (a viewer's edits, a blast placed live); the state is kept.
+    pub fn set_wind(&mut self, ctx: &GpuContext, wind: &WindScene) -> Result<(), GpuError> {
+        let (fields, waves) = wind.pack();
+        (self.fields, self.waves) = crate::wind_sample::upload_wind(ctx, &fields, &waves)?;
+        Ok(())
+    }
+
     /// The pose seam's buffers on the GPU, when built with the tree.
     pub fn gpu_pose(&self) -> Option<&GpuPose> {
         self.pose.as_ref()

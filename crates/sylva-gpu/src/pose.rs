@@ -216,6 +216,14 @@ pub struct GpuZioma {
 }
 
 impl GpuZioma {
+    /// Replaces the wind (a viewer's edits, a blast placed live).
+    pub fn set_wind(&mut self, ctx: &GpuContext, wind: &WindScene) -> Result<(), GpuError> {
+        let (fields, waves) = wind.pack();
+        (self.fields, self.waves) = crate::wind_sample::upload_wind(ctx, &fields, &waves)?;
+        self.packed = (fields, waves);
+        Ok(())
+    }
+
     /// The pose seam's buffers on the GPU (for meshing without a round trip).
     pub fn gpu_pose(&self) -> &GpuPose {
         &self.pose
@@ -324,6 +332,13 @@ pub struct GpuAkagi {
 }
 
 impl GpuAkagi {
+    /// Replaces the wind (a viewer's edits, a blast placed live); the state is kept.
+    pub fn set_wind(&mut self, ctx: &GpuContext, wind: &WindScene) -> Result<(), GpuError> {
+        let (fields, waves) = wind.pack();
+        (self.fields, self.waves) = crate::wind_sample::upload_wind(ctx, &fields, &waves)?;
+        Ok(())
+    }
+
     /// The pose seam's buffers on the GPU (for meshing without a round trip).
     pub fn gpu_pose(&self) -> &GpuPose {
         &self.pose
@@ -446,6 +461,13 @@ pub struct GpuSkjermo {
 }
 
 impl GpuSkjermo {
+    /// Replaces the wind (a viewer's edits, a blast placed live); the state is kept.
+    pub fn set_wind(&mut self, ctx: &GpuContext, wind: &WindScene) -> Result<(), GpuError> {
+        let (fields, waves) = wind.pack();
+        (self.fields, self.waves) = crate::wind_sample::upload_wind(ctx, &fields, &waves)?;
+        Ok(())
+    }
+
     /// Skjermo's per-stem constants on the GPU (`RawSkjermoStem`).
     pub fn stems_buffer(&self) -> &wgpu::Buffer {
         &self.stems

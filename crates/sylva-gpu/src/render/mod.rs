@@ -426,8 +426,14 @@ impl Renderer {
                 view_formats: &[],
             })
         };
-        let resolve =
-            texture("image", COLOR_FORMAT, 1, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
+        let resolve = texture(
+            "image",
+            COLOR_FORMAT,
+            1,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
         let color = if settings.msaa > 1 {
             texture("msaa colour", COLOR_FORMAT, settings.msaa, wgpu::TextureUsages::RENDER_ATTACHMENT)
                 .create_view(&Default::default())
@@ -462,6 +468,11 @@ impl Renderer {
             readback,
             padded_row,
         })
+    }
+
+    /// The rendered image (RGBA8 sRGB), for a window to show as a texture.
+    pub fn image_view(&self) -> wgpu::TextureView {
+        self.resolve.create_view(&Default::default())
     }
 
     /// The settings in use (MSAA as granted).
