@@ -25,6 +25,10 @@ use sylva_gpu::mesh::GpuMesh;
 use sylva_gpu::render::{DrawItem, Instance, Renderer};
 use sylva_gpu::skin::GpuSkin;
 
+/// Most GPU memory a tree's skinned instances (Zioma copies) may take: beyond this a scene
+/// asks for more vertex memory than most GPUs have to spare.
+pub(crate) const MAX_SKINNED_BYTES: u64 = 2 << 30;
+
 /// One tree's animation, on the CPU or the GPU.
 enum Anim {
     ZiomaCpu(Zioma),
@@ -423,6 +427,19 @@ impl Entry {
         let mut bark_triangles = layout.tube_indices.len() / 3;
         let groups = st.phase_groups();
         let drawn = if st.method == MethodName::Zioma && inst.len() > 1 {
+            let vertices = layout.tube_vertex_count() + layout.leaf_vertex_count();
+            let bytes = (vertices * std::mem::size_of::<sylva_core::mesh::RawVertex>() * inst.len()) as u64;
+            if bytes > MAX_SKINNED_BYTES {
+                anyhow::bail!(
+                    "{}: tree[{i}]: {} skinned instances of {vertices} vertices need {:.1} GiB of vertex buffers; \
+                     at most {} GiB: use fewer copies, fewer `sides`/`leaf_sides`, or a stateful method \
+                     (whose copies share their simulations' meshes)",
+                    scene.file,
+                    inst.len(),
+                    bytes as f64 / (1u64 << 30) as f64,
+                    MAX_SKINNED_BYTES >> 30
+                );
+            }
             Drawn::Forest(Box::new(ZiomaForest::new(ctx, &tree, &layout, &inst, gpu, st.seed, wind)?))
         } else {
             let grid = if st.method == MethodName::Skjermo {
@@ -528,6 +545,28 @@ impl Entry {
                 Pose::from_rotations_instances(&self.tree, &delta).swap_remove(0)
             }
         })
+    }
+
+    /// HSM's particles per simulation (`None` for the other methods).
+    pub(crate) fn particles(&self) -> Option<usize> {
+        let Drawn::Groups(groups) = &self.drawn else { return None };
+        match &groups[0].anim {
+            Anim::HsmCpu(m, _) | Anim::HsmGpu(m, _) => Some(m.layout.particle_count()),
+            _ => None,
+        }
+    }
+
+    /// HSM's particles and clusters in the first simulation: (particles, cluster centres of
+    /// mass in the tree's frame); `None` for the other methods.
+    pub(crate) fn clusters(&self, ctx: &GpuContext) -> Result<Option<(usize, Vec<Vec3>)>> {
+        let Drawn::Groups(groups) = &self.drawn else { return Ok(None) };
+        let state = match &groups[0].anim {
+            Anim::HsmCpu(_, s) => Cow::Borrowed(&**s),
+            Anim::HsmGpu(_, g) => Cow::Owned(g.read_state(ctx)?),
+            _ => return Ok(None),
+        };
+        let centres = state.clusters.iter().map(|c| Vec3::new(c.cm[0], c.cm[1], c.cm[2])).collect();
+        Ok(Some((state.position.len(), centres)))
     }
 
     /// Mean distance of the segments' joints from rest, m, in the tree's first simulation

@@ -11,7 +11,7 @@ use std::time::{Instant, SystemTime};
 use sylva_core::scene::{BackendChoice, MethodName, Scene};
 use sylva_core::species::PRESETS;
 use sylva_core::wind::raw::{RawField, RawWave};
-use sylva_core::wind::{Blast, Constant, Vortex, WindField, WindScene};
+use sylva_core::wind::{Blast, Constant, GustFront, Vortex, WindField, WindScene};
 use sylva_gpu::GpuContext;
 use sylva_gpu::render::{Camera, Lighting, RenderSettings, Renderer};
 use winit::application::ApplicationHandler;
@@ -31,11 +31,44 @@ const MAX_FOREST: usize = 5_000;
 /// Per-frame costs, ms.
 #[derive(Debug, Clone, Copy, Default)]
 struct Stages {
+    /// Composing and uploading the wind (CPU).
     wind: f64,
+    /// CPU methods' steps and recording every simulation and mesh (CPU).
     simulate: f64,
+    /// The GPU's share of simulation and meshing (timestamp queries; 0 without them).
+    gpu_mesh: f64,
+    /// The GPU's shadow and main passes (timestamp queries; 0 without them).
+    gpu_draw: f64,
+    /// From recording the draw to presenting, waits included (CPU wall clock).
     draw: f64,
+    /// The panel (CPU).
     ui: f64,
+    /// The whole frame.
     frame: f64,
+}
+
+impl Stages {
+    fn add(&mut self, o: &Stages) {
+        self.wind += o.wind;
+        self.simulate += o.simulate;
+        self.gpu_mesh += o.gpu_mesh;
+        self.gpu_draw += o.gpu_draw;
+        self.draw += o.draw;
+        self.ui += o.ui;
+        self.frame += o.frame;
+    }
+
+    fn scaled(&self, k: f64) -> Stages {
+        Stages {
+            wind: self.wind * k,
+            simulate: self.simulate * k,
+            gpu_mesh: self.gpu_mesh * k,
+            gpu_draw: self.gpu_draw * k,
+            draw: self.draw * k,
+            ui: self.ui * k,
+            frame: self.frame * k,
+        }
+    }
 }
 
 /// The scene as the viewer runs it: what the panel edits and the script drives.
@@ -47,8 +80,10 @@ struct Sim {
     last_watch: Instant,
     reload_error: Option<String>,
     build_error: Option<String>,
-    /// The scene's own wind (preset or file).
+    /// The scene's own wind (preset or file), as edited in the panel.
     base_wind: WindScene,
+    /// Whether the panel changed `base_wind` (saved beside the scene on save).
+    wind_edited: bool,
     scene_wind: bool,
     /// A constant wind on top: (direction, degrees from +X toward +Z; speed, m/s).
     extra_wind: Option<(f32, f32)>,
@@ -84,6 +119,7 @@ impl Sim {
             reload_error: None,
             build_error: None,
             base_wind,
+            wind_edited: false,
             scene_wind: true,
             extra_wind: None,
             effects: Vec::new(),
@@ -132,6 +168,7 @@ impl Sim {
         self.effects.retain(|f| match f {
             WindField::Blast(b) => t < b.start + 8.0 * b.decay + b.radius / b.speed.max(1.0),
             WindField::Vortex(v) => t < v.start + v.duration + v.fade,
+            WindField::GustFront(g) => t < g.start + 4.0,
             _ => true,
         });
         fields.extend(self.effects.iter().cloned());
@@ -225,9 +262,31 @@ impl Sim {
                 duration: 6.0,
                 fade: 1.0,
             }),
-            Tool::None => return,
+            Tool::Push | Tool::None => return,
         };
         self.effects.push(field);
+        self.wind_changed();
+    }
+
+    /// A gust along a drag on the ground from `a` to `b` (x, z): a narrow front that starts
+    /// behind `a` and runs toward `b`, stronger for a longer drag.
+    fn push(&mut self, a: Vec3, b: Vec3) {
+        let d = glam::Vec2::new(b.x - a.x, b.z - a.z);
+        let len = d.length();
+        if len < 0.1 {
+            return;
+        }
+        let dir = d / len;
+        self.effects.push(WindField::GustFront(GustFront {
+            origin: [a.x - 4.0 * dir.x, a.z - 4.0 * dir.y],
+            direction_deg: dir.y.atan2(dir.x).to_degrees(),
+            strength: (2.0 * len).clamp(4.0, self.effect_strength.max(4.0)),
+            speed: 12.0,
+            width: 3.0,
+            length: 6.0 + len,
+            radius: 5.0,
+            start: self.t,
+        }));
         self.wind_changed();
     }
 
@@ -254,6 +313,7 @@ impl Sim {
             Ok((scene, wind)) => {
                 let old = std::mem::replace(&mut self.scene, scene);
                 self.base_wind = wind;
+                self.wind_edited = false;
                 self.dt = 1.0 / self.scene.output.sim_rate;
                 self.compose_wind();
                 match self.rebuild_all() {
@@ -302,7 +362,7 @@ impl Sim {
         })
     }
 
-    fn report(&self) -> Result<serde_json::Value> {
+    fn report(&self, stages: &Stages, frames: u32) -> Result<serde_json::Value> {
         let wind = (&self.packed.0[..], &self.packed.1[..]);
         let mut trees = Vec::new();
         for e in &self.entries {
@@ -323,6 +383,13 @@ impl Sim {
             "wind_fields": self.wind.fields.len(),
             "effects": self.effects.len(),
             "triangles": self.entries.iter().map(|e| e.triangles).sum::<usize>(),
+            "instances": self.entries.iter().map(|e| e.instances).sum::<usize>(),
+            "stages_ms": {
+                "frames": frames,
+                "frame": stages.frame, "wind": stages.wind, "simulate": stages.simulate,
+                "gpu_simulate_mesh": stages.gpu_mesh, "gpu_draw": stages.gpu_draw,
+                "draw": stages.draw, "ui": stages.ui,
+            },
             "trees": trees,
         }))
     }
@@ -424,7 +491,14 @@ struct App {
     last_frame: Instant,
     show_wind: bool,
     show_skeleton: bool,
+    show_clusters: bool,
     status: String,
+    /// Stage times summed since the last report, and the frames they cover.
+    sums: Stages,
+    summed: u32,
+    push_from: Option<egui::Pos2>,
+    /// GPU timers: simulation and meshing, drawing (with timestamp queries).
+    timers: Option<(sylva_gpu::timer::GpuTimer, sylva_gpu::timer::GpuTimer)>,
 }
 
 /// Runs the viewer until the window closes or the script quits.
@@ -453,7 +527,12 @@ pub fn run(args: &ViewArgs, script: Vec<Command>) -> Result<()> {
         last_frame: Instant::now(),
         show_wind: true,
         show_skeleton: false,
+        show_clusters: false,
         status: String::new(),
+        sums: Stages::default(),
+        summed: 0,
+        push_from: None,
+        timers: sylva_gpu::timer::GpuTimer::new(ctx).zip(sylva_gpu::timer::GpuTimer::new(ctx)),
     };
     event_loop.run_app(&mut app).context("running the window")?;
     match app.error {
@@ -542,9 +621,17 @@ impl App {
                     self.sim.poll_reload(true);
                 }
                 Command::Screenshot(p) => self.screenshot(&p)?,
+                Command::Forest(i, n) => {
+                    if i >= self.sim.scene.trees.len() {
+                        anyhow::bail!("script: `forest {i}`: the scene has {} trees", self.sim.scene.trees.len());
+                    }
+                    self.sim.set_forest(i, n);
+                }
                 Command::Report(p) => {
-                    let json = serde_json::to_string_pretty(&self.sim.report()?)?;
+                    let mean = self.sums.scaled(1.0 / self.summed.max(1) as f64);
+                    let json = serde_json::to_string_pretty(&self.sim.report(&mean, self.summed)?)?;
                     write_atomic(&p, json.as_bytes())?;
+                    (self.sums, self.summed) = (Stages::default(), 0);
                 }
                 Command::Quit => {
                     event_loop.exit();
@@ -592,7 +679,13 @@ impl App {
         };
         let ctx = self.sim.ctx;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        if let Some((t, _)) = &self.timers {
+            t.begin(&mut encoder);
+        }
         let (wind_ms, sim_ms) = self.sim.advance(seconds, &mut encoder)?;
+        if let Some((t, _)) = &self.timers {
+            t.end(&mut encoder);
+        }
         self.sim.frames += 1;
 
         let Some(gfx) = &mut self.gfx else { return Ok(()) };
@@ -603,19 +696,12 @@ impl App {
         let mut view_rect = egui::Rect::NOTHING;
         let texture = gfx.view.as_ref().map(|v| (v.texture, v.size));
         let stages = self.stages;
+        let mut overlays = [self.show_wind, self.show_skeleton, self.show_clusters];
+        let tool = self.sim.tool;
         let output = gfx.egui.run_ui(raw, |ui| {
             egui::Panel::left("panel").resizable(true).default_size(300.0).show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
-                    panel(
-                        ui,
-                        &mut self.sim,
-                        &mut self.orbit,
-                        &stages,
-                        &mut self.show_wind,
-                        &mut self.show_skeleton,
-                        &self.status,
-                        &mut actions,
-                    );
+                    panel(ui, &mut self.sim, &mut self.orbit, &stages, &mut overlays, &self.status, &mut actions);
                 });
             });
             egui::CentralPanel::default().frame(egui::Frame::NONE).show(ui, |ui| {
@@ -625,17 +711,25 @@ impl App {
                     let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
                     ui.painter().image(id, view_rect, uv, egui::Color32::WHITE);
                 }
-                interact(ui, &response, view_rect, &mut self.orbit, &mut actions);
-                overlay(ui, view_rect, &self.sim, &self.orbit, &stages, self.show_wind, self.show_skeleton);
+                interact(ui, &response, view_rect, tool, &mut self.push_from, &mut self.orbit, &mut actions);
+                overlay(ui, view_rect, &self.sim, &self.orbit, &stages, overlays);
             });
         });
         let ui_ms = ms(ui_start.elapsed());
+        [self.show_wind, self.show_skeleton, self.show_clusters] = overlays;
         for a in actions {
             match a {
-                Action::Place(u, v, tool) => {
+                Action::Place(u, v) => {
                     let aspect = view_rect.width() / view_rect.height().max(1.0);
                     if let Some(p) = self.orbit.ground_point(u, v, aspect) {
-                        self.sim.place_effect(p.x, p.z, tool);
+                        self.sim.place_effect(p.x, p.z, self.sim.tool);
+                    }
+                }
+                Action::Push(a, b) => {
+                    let aspect = view_rect.width() / view_rect.height().max(1.0);
+                    let ground = |(u, v): (f32, f32)| self.orbit.ground_point(u, v, aspect);
+                    if let (Some(a), Some(b)) = (ground(a), ground(b)) {
+                        self.sim.push(a, b);
                     }
                 }
                 Action::Save => {
@@ -676,7 +770,13 @@ impl App {
         };
         let globals = view.renderer.globals(&self.orbit.camera(), &light, self.sim.bounds());
         let items: Vec<_> = self.sim.entries.iter().flat_map(Entry::draw_items).collect();
+        if let Some((_, t)) = &self.timers {
+            t.begin(&mut encoder);
+        }
         view.renderer.record(ctx, &mut encoder, &globals, &items);
+        if let Some((_, t)) = &self.timers {
+            t.end(&mut encoder);
+        }
         drop(items);
         gfx.state.handle_platform_output(&gfx.window, output.platform_output);
         // Texture changes are applied every frame, presented or not (egui insists); frees
@@ -734,25 +834,53 @@ impl App {
             gfx.painter.free_texture(id);
         }
         textures.clear();
+        let (gpu_mesh, gpu_draw) = match &self.timers {
+            Some((m, d)) => (m.read(ctx)?.map_or(0.0, ms), d.read(ctx)?.map_or(0.0, ms)),
+            None => (0.0, 0.0),
+        };
         self.stages = Stages {
             wind: wind_ms,
             simulate: sim_ms,
+            gpu_mesh,
+            gpu_draw,
             draw: ms(draw_start.elapsed()),
             ui: ui_ms,
             frame: ms(frame_start.elapsed()),
         };
+        self.sums.add(&self.stages);
+        self.summed += 1;
         Ok(())
     }
 }
 
 /// What the panel and the view ask for after the UI pass.
 enum Action {
-    Place(f32, f32, Tool),
+    /// A click at view point (u, v) with the current tool.
+    Place(f32, f32),
+    /// A push dragged from one view point to another.
+    Push((f32, f32), (f32, f32)),
     Save,
 }
 
 fn save_scene(sim: &mut Sim) -> Result<PathBuf> {
     let path = sim.path.clone().unwrap_or_else(|| PathBuf::from("scene.toml"));
+    // Wind edited in the panel (and the extra constant wind) go to a wind file beside the
+    // scene, which the scene then names.
+    if sim.wind_edited || sim.extra_wind.is_some() || !sim.scene_wind {
+        let mut wind = if sim.scene_wind { sim.base_wind.clone() } else { WindScene::default() };
+        if let Some((deg, speed)) = sim.extra_wind {
+            let a = deg.to_radians();
+            wind.fields.push(WindField::Constant(Constant { direction: [a.cos(), 0.0, a.sin()], speed }));
+        }
+        let stem = path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+        let name = format!("{stem}.wind.toml");
+        let file = path.with_file_name(&name);
+        let text = toml::to_string_pretty(&wind).context("writing the wind as TOML")?;
+        write_atomic(&file, text.as_bytes())?;
+        sim.scene.wind = name;
+        sim.base_wind = wind;
+        (sim.wind_edited, sim.extra_wind, sim.scene_wind) = (false, None, true);
+    }
     write_atomic(&path, sim.scene.to_toml().as_bytes())?;
     if sim.path.is_none() {
         sim.path = Some(path.clone());
@@ -763,9 +891,22 @@ fn save_scene(sim: &mut Sim) -> Result<PathBuf> {
 }
 
 /// Orbit (left drag), pan (right or middle drag), zoom (scroll), place (left click).
-fn interact(ui: &egui::Ui, r: &egui::Response, rect: egui::Rect, orbit: &mut Orbit, actions: &mut Vec<Action>) {
+fn interact(
+    ui: &egui::Ui,
+    r: &egui::Response,
+    rect: egui::Rect,
+    tool: Tool,
+    push_from: &mut Option<egui::Pos2>,
+    orbit: &mut Orbit,
+    actions: &mut Vec<Action>,
+) {
     let d = r.drag_delta();
-    if r.dragged_by(egui::PointerButton::Primary) {
+    let uv = |p: egui::Pos2| ((p.x - rect.left()) / rect.width(), (p.y - rect.top()) / rect.height());
+    if tool == Tool::Push && r.dragged_by(egui::PointerButton::Primary) {
+        if r.drag_started() {
+            *push_from = r.interact_pointer_pos();
+        }
+    } else if r.dragged_by(egui::PointerButton::Primary) {
         orbit.yaw -= d.x * 0.008;
         orbit.pitch = (orbit.pitch + d.y * 0.008).clamp(-0.1, 1.5);
     } else if r.dragged_by(egui::PointerButton::Secondary) || r.dragged_by(egui::PointerButton::Middle) {
@@ -782,11 +923,16 @@ fn interact(ui: &egui::Ui, r: &egui::Response, rect: egui::Rect, orbit: &mut Orb
             orbit.distance = (orbit.distance * (-scroll * 0.002).exp()).clamp(0.5, 2_000.0);
         }
     }
+    if r.drag_stopped()
+        && let (Some(a), Some(b)) = (push_from.take(), r.interact_pointer_pos())
+    {
+        actions.push(Action::Push(uv(a), uv(b)));
+    }
     if r.clicked()
         && let Some(p) = r.interact_pointer_pos()
     {
-        let (u, v) = ((p.x - rect.left()) / rect.width(), (p.y - rect.top()) / rect.height());
-        actions.push(Action::Place(u, v, Tool::Blast));
+        let (u, v) = uv(p);
+        actions.push(Action::Place(u, v));
     }
 }
 
@@ -796,8 +942,7 @@ fn panel(
     sim: &mut Sim,
     orbit: &mut Orbit,
     stages: &Stages,
-    show_wind: &mut bool,
-    show_skeleton: &mut bool,
+    overlays: &mut [bool; 3],
     status: &str,
     actions: &mut Vec<Action>,
 ) {
@@ -847,10 +992,17 @@ fn panel(
         sim.extra_wind = extra.then_some((deg, speed));
         sim.wind_changed();
     }
+    egui::CollapsingHeader::new("scene wind fields").show(ui, |ui| {
+        if wind_fields(ui, &mut sim.base_wind) {
+            sim.wind_edited = true;
+            sim.wind_changed();
+        }
+    });
     ui.horizontal(|ui| {
         ui.label("click places:");
         ui.radio_value(&mut sim.tool, Tool::Blast, "blast");
         ui.radio_value(&mut sim.tool, Tool::Vortex, "vortex");
+        ui.radio_value(&mut sim.tool, Tool::Push, "push (drag)");
         ui.radio_value(&mut sim.tool, Tool::None, "nothing");
     });
     ui.add(egui::Slider::new(&mut sim.effect_strength, 2.0..=60.0).text("strength m/s"));
@@ -870,6 +1022,11 @@ fn panel(
                 for p in PRESETS {
                     rebuild |= ui.selectable_value(&mut st.species, p.name.to_string(), p.name).changed();
                 }
+            });
+            ui.horizontal(|ui| {
+                ui.label("or file:");
+                let edit = ui.add(egui::TextEdit::singleline(&mut st.species).desired_width(150.0));
+                rebuild |= edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
             });
             ui.horizontal(|ui| {
                 rebuild |= ui.add(egui::DragValue::new(&mut st.seed).prefix("seed ")).changed();
@@ -913,19 +1070,79 @@ fn panel(
 
     ui.separator();
     ui.strong("Overlays");
-    ui.checkbox(show_wind, "wind arrows");
-    ui.checkbox(show_skeleton, "skeleton (first instance of each tree)");
+    ui.checkbox(&mut overlays[0], "wind arrows");
+    ui.checkbox(&mut overlays[1], "skeleton (first instance of each tree)");
+    ui.checkbox(&mut overlays[2], "HSM clusters (centres of mass)");
     ui.separator();
     ui.strong("Frame");
     ui.monospace(format!(
-        "frame    {:6.1} ms\nwind     {:6.1} ms\nsimulate {:6.1} ms\ndraw     {:6.1} ms\nui       {:6.1} ms",
-        stages.frame, stages.wind, stages.simulate, stages.draw, stages.ui
+        "frame         {:6.1} ms\nwind          {:6.1} ms\nsimulate      {:6.1} ms\n GPU sim+mesh {:6.1} ms\n GPU draw     {:6.1} ms\ndraw+present  {:6.1} ms\nui            {:6.1} ms",
+        stages.frame, stages.wind, stages.simulate, stages.gpu_mesh, stages.gpu_draw, stages.draw, stages.ui
     ));
     let segments: usize = sim.entries.iter().map(|e| e.tree.segments.len() * e.simulations).sum();
     let triangles: usize = sim.entries.iter().map(|e| e.triangles).sum();
     let instances: usize = sim.entries.iter().map(|e| e.instances).sum();
-    ui.monospace(format!("{segments} segments simulated\n{triangles} triangles\n{instances} instances"));
+    let particles: usize = sim.entries.iter().filter_map(|e| e.particles().map(|n| n * e.simulations)).sum();
+    ui.monospace(format!(
+        "{segments} segments simulated\n{particles} particles (HSM)\n{triangles} triangles\n{instances} instances"
+    ));
     ui.label(format!("GPU: {}", sim.ctx.summary.name));
+}
+
+/// Sliders for the fields of the scene's wind; true when one moved.
+fn wind_fields(ui: &mut egui::Ui, wind: &mut WindScene) -> bool {
+    let mut changed = false;
+    for (k, f) in wind.fields.iter_mut().enumerate() {
+        ui.push_id(("field", k), |ui| match f {
+            WindField::Constant(c) => {
+                ui.label("constant");
+                let mut deg = c.direction[2].atan2(c.direction[0]).to_degrees();
+                if ui.add(egui::Slider::new(&mut deg, -180.0..=180.0).text("direction °")).changed() {
+                    let a = deg.to_radians();
+                    c.direction = [a.cos(), c.direction[1], a.sin()];
+                    changed = true;
+                }
+                changed |= ui.add(egui::Slider::new(&mut c.speed, 0.0..=40.0).text("speed m/s")).changed();
+            }
+            WindField::SumOfSines(s) => {
+                ui.label("sum of sines (Skjermo eqs. 11–14)");
+                for (i, w) in s.waves.iter_mut().enumerate() {
+                    ui.push_id(i, |ui| {
+                        changed |=
+                            ui.add(egui::Slider::new(&mut w.amplitude, 0.0..=10.0).text("amplitude m/s")).changed();
+                        changed |= ui
+                            .add(egui::Slider::new(&mut w.direction_deg, -180.0..=180.0).text("direction °"))
+                            .changed();
+                        changed |=
+                            ui.add(egui::Slider::new(&mut w.wavelength, 1.0..=200.0).text("wavelength m")).changed();
+                        changed |= ui.add(egui::Slider::new(&mut w.speed, 0.0..=20.0).text("speed m/s")).changed();
+                    });
+                }
+            }
+            WindField::Turbulence(t) => {
+                ui.label("turbulence (1/f^β)");
+                changed |= ui.add(egui::Slider::new(&mut t.intensity, 0.0..=8.0).text("gustiness (rms m/s)")).changed();
+                changed |= ui.add(egui::Slider::new(&mut t.beta, 0.5..=3.0).text("β")).changed();
+            }
+            WindField::GustFront(g) => {
+                ui.label("gust front");
+                changed |= ui.add(egui::Slider::new(&mut g.strength, 0.0..=30.0).text("strength m/s")).changed();
+                changed |=
+                    ui.add(egui::Slider::new(&mut g.direction_deg, -180.0..=180.0).text("direction °")).changed();
+            }
+            WindField::Vortex(v) => {
+                ui.label("vortex");
+                changed |= ui.add(egui::Slider::new(&mut v.strength, -40.0..=40.0).text("strength m/s")).changed();
+                changed |= ui.add(egui::Slider::new(&mut v.radius, 0.5..=40.0).text("radius m")).changed();
+            }
+            WindField::Blast(b) => {
+                ui.label("blast");
+                changed |= ui.add(egui::Slider::new(&mut b.strength, 0.0..=100.0).text("strength m/s")).changed();
+            }
+        });
+        ui.separator();
+    }
+    changed
 }
 
 /// Frame time and counts over the view, wind arrows on the ground.
@@ -935,8 +1152,7 @@ fn overlay(
     sim: &Sim,
     orbit: &Orbit,
     stages: &Stages,
-    show_wind: bool,
-    show_skeleton: bool,
+    [show_wind, show_skeleton, show_clusters]: [bool; 3],
 ) {
     let painter = ui.painter_at(rect);
     painter.text(
@@ -979,6 +1195,16 @@ fn overlay(
                         b - a,
                         egui::Stroke::new(1.5, egui::Color32::from_rgba_unmultiplied(255, 240, 120, 200)),
                     );
+                }
+            }
+        }
+    }
+    if show_clusters {
+        for e in &sim.entries {
+            let Ok(Some((_, centres))) = e.clusters(sim.ctx) else { continue };
+            for c in centres {
+                if let Some(p) = project(e.transform.transform_point3(c)) {
+                    painter.circle_filled(p, 2.0, egui::Color32::from_rgb(90, 200, 255));
                 }
             }
         }

@@ -14,9 +14,10 @@
 //! blast 3.0 -2.0       # a blast at ground point (x, z)
 //! wind 90 12           # a constant extra wind: direction (degrees from +X toward +Z), m/s
 //! method 0 akagi       # tree 0's method (rebuilds it)
+//! forest 0 1000        # tree 0 as a forest of 1,000 instances
 //! overwrite-scene F    # copy F over the scene file (as an editor would), for hot reload
 //! screenshot out.png   # the 3D view as a PNG
-//! report out.json      # frame count, time, every tree's displacement, the reload status
+//! report out.json      # frames, time, stage times, every tree's displacement, reload status
 //! quit
 //! ```
 
@@ -56,6 +57,8 @@ pub enum Command {
     Wind(f32, f32),
     /// Set a tree's method.
     Method(usize, sylva_core::scene::MethodName),
+    /// Make a tree a forest of this many instances.
+    Forest(usize, usize),
     /// Copy a file over the scene file.
     OverwriteScene(PathBuf),
     /// Save the 3D view.
@@ -74,6 +77,8 @@ pub enum Tool {
     Blast,
     /// A whirlwind turning about a vertical axis.
     Vortex,
+    /// A gust along a drag (dragging with this tool pushes instead of orbiting).
+    Push,
     /// Nothing: clicks only select.
     None,
 }
@@ -131,8 +136,9 @@ pub fn parse_script(text: &str, file: &str) -> Result<Vec<Command>> {
                 Command::Tool(match words[1] {
                     "blast" => Tool::Blast,
                     "vortex" => Tool::Vortex,
+                    "push" => Tool::Push,
                     "none" => Tool::None,
-                    w => bail!("{}: tool `{w}`: expected blast, vortex or none", at()),
+                    w => bail!("{}: tool `{w}`: expected blast, vortex, push or none", at()),
                 })
             }
             "blast" => {
@@ -156,6 +162,16 @@ pub fn parse_script(text: &str, file: &str) -> Result<Vec<Command>> {
                 })?;
                 Command::Method(tree, m)
             }
+            "forest" => {
+                arity(2)?;
+                let parse =
+                    |w: &str| w.parse::<usize>().map_err(|_| anyhow::anyhow!("{}: `{w}` is not a whole number", at()));
+                let (tree, n) = (parse(words[1])?, parse(words[2])?);
+                if !(1..=100_000).contains(&n) {
+                    bail!("{}: `{line}`: expected 1 to 100,000 instances", at());
+                }
+                Command::Forest(tree, n)
+            }
             "overwrite-scene" => {
                 arity(1)?;
                 Command::OverwriteScene(words[1].into())
@@ -173,7 +189,7 @@ pub fn parse_script(text: &str, file: &str) -> Result<Vec<Command>> {
                 Command::Quit
             }
             w => bail!(
-                "{}: unknown command `{w}`: expected frames, click, tool, blast, wind, method, overwrite-scene, screenshot, report or quit",
+                "{}: unknown command `{w}`: expected frames, click, tool, blast, wind, method, forest, overwrite-scene, screenshot, report or quit",
                 at()
             ),
         };
@@ -229,7 +245,8 @@ mod tests {
             ("frames 2.5", "whole number"),
             ("click 2 0", "0 to 1"),
             ("wobble", "unknown command `wobble`"),
-            ("tool hammer", "blast, vortex or none"),
+            ("tool hammer", "blast, vortex, push or none"),
+            ("forest 0 0", "1 to 100,000"),
             ("method 0 teleport", "zioma, akagi"),
             ("quit now", "takes 0"),
         ] {
