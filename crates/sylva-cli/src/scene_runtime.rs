@@ -16,8 +16,8 @@ use sylva_core::animate::{Pose, seam_buffers};
 use sylva_core::mesh::{DeformLayout, DeformerParams, MeshLayout, MeshParams, SkinLayout};
 use sylva_core::scene::{BackendChoice, MethodName, Scene, SceneTree};
 use sylva_core::species::SpeciesSource;
-use sylva_core::wind::WindScene;
 use sylva_core::wind::raw::{RawField, RawWave};
+use sylva_core::wind::{WindField, WindScene};
 use sylva_core::{Limits, Tree};
 use sylva_gpu::GpuContext;
 use sylva_gpu::deform::GpuDeform;
@@ -243,6 +243,11 @@ struct Group {
     count: u32,
     /// Extra pre-roll steps: the group's phase offset in the wind.
     lead_steps: usize,
+    /// The offset in seconds: this group's clock runs this far ahead of the scene's.
+    lead_s: f32,
+    /// The group's own wind when live effects must reach it on its clock (see
+    /// [`Entry::set_wind`]); the shared wind otherwise.
+    own_wind: Option<(Vec<RawField>, Vec<RawWave>)>,
 }
 
 impl Group {
@@ -362,7 +367,11 @@ impl Entry {
             Drawn::Groups(groups) => {
                 for g in groups {
                     let lead = if preroll { g.lead_steps } else { 0 };
-                    g.advance(ctx, &self.tree, wind, t, dt, steps + lead, encoder)?;
+                    let own = g.own_wind.take();
+                    let w = own.as_ref().map_or(wind, |(f, w)| (&f[..], &w[..]));
+                    let done = g.advance(ctx, &self.tree, w, t, dt, steps + lead, encoder);
+                    g.own_wind = own;
+                    done?;
                 }
                 Ok(())
             }
@@ -462,6 +471,8 @@ impl Entry {
                     instances: Renderer::instances(ctx, &members),
                     count: members.len() as u32,
                     lead_steps: (group.offset_s / dt).round() as usize,
+                    lead_s: (group.offset_s / dt).round() * dt,
+                    own_wind: None,
                 });
             }
             Drawn::Groups(built)
@@ -519,16 +530,34 @@ impl Entry {
     }
 
     /// Hands a new wind to every GPU simulation of this tree.
-    pub(crate) fn set_wind(&mut self, ctx: &GpuContext, wind: &WindScene) -> Result<()> {
+    /// `wind` is the scene's wind; `effects` (blasts, vortices, pushes placed live, times on
+    /// the scene's clock) are added to it. A phase group whose clock runs ahead gets the
+    /// effects shifted onto its clock, so a blast reaches every copy at the same moment.
+    pub(crate) fn set_wind(&mut self, ctx: &GpuContext, wind: &WindScene, effects: &[WindField]) -> Result<()> {
+        let on_clock = |lead: f32| {
+            let mut w = wind.clone();
+            w.fields.extend(effects.iter().cloned().map(|mut f| {
+                match &mut f {
+                    WindField::Blast(b) => b.start += lead,
+                    WindField::Vortex(v) => v.start += lead,
+                    WindField::GustFront(g) => g.start += lead,
+                    _ => {}
+                }
+                f
+            }));
+            w
+        };
         match &mut self.drawn {
             Drawn::Groups(groups) => {
                 for g in groups {
-                    g.anim.set_wind(ctx, wind)?;
+                    let w = on_clock(g.lead_s);
+                    g.anim.set_wind(ctx, &w)?;
+                    g.own_wind = (g.lead_s != 0.0 && !effects.is_empty()).then(|| w.pack());
                 }
             }
             Drawn::Forest(f) => {
                 if let Some(g) = &mut f.gpu {
-                    g.set_wind(ctx, wind)?;
+                    g.set_wind(ctx, &on_clock(0.0))?;
                 }
             }
         }
@@ -567,6 +596,24 @@ impl Entry {
         };
         let centres = state.clusters.iter().map(|c| Vec3::new(c.cm[0], c.cm[1], c.cm[2])).collect();
         Ok(Some((state.position.len(), centres)))
+    }
+
+    /// [`Entry::displacement`] of every simulation (phase group), each on its own clock.
+    pub(crate) fn group_displacements(
+        &self,
+        ctx: &GpuContext,
+        wind: (&[RawField], &[RawWave]),
+        t: f32,
+    ) -> Result<Vec<f32>> {
+        let Drawn::Groups(groups) = &self.drawn else { return Ok(vec![self.displacement(ctx, wind, t)?]) };
+        let rest = &self.tree.segments.start;
+        groups
+            .iter()
+            .map(|g| {
+                let pose = g.anim.pose(ctx, &self.tree, wind, t + g.lead_s)?;
+                Ok(pose.start.iter().zip(rest).map(|(p, r)| p.distance(*r)).sum::<f32>() / rest.len().max(1) as f32)
+            })
+            .collect()
     }
 
     /// Mean distance of the segments' joints from rest, m, in the tree's first simulation

@@ -89,6 +89,9 @@ struct Sim {
     extra_wind: Option<(f32, f32)>,
     /// Blasts and vortices placed live.
     effects: Vec<WindField>,
+    /// The scene's and the extra wind, without the effects.
+    steady: WindScene,
+    /// Everything: what the scene's clock sees.
     wind: WindScene,
     packed: (Vec<RawField>, Vec<RawWave>),
     entries: Vec<Entry>,
@@ -123,6 +126,7 @@ impl Sim {
             scene_wind: true,
             extra_wind: None,
             effects: Vec::new(),
+            steady: WindScene::default(),
             wind: WindScene::default(),
             packed: (Vec::new(), Vec::new()),
             entries: Vec::new(),
@@ -163,24 +167,30 @@ impl Sim {
             let a = deg.to_radians();
             fields.push(WindField::Constant(Constant { direction: [a.cos(), 0.0, a.sin()], speed }));
         }
-        // Effects that are over no longer cost a term per sample.
-        let t = self.t;
+        self.steady = WindScene { fields: fields.clone() };
+        fields.extend(self.effects.iter().cloned());
+        self.wind = WindScene { fields };
+        self.packed = self.wind.pack();
+    }
+
+    /// Drops the effects that are over (they would still cost a term per sample); true
+    /// when any was.
+    fn expire_effects(&mut self) -> bool {
+        let (t, before) = (self.t, self.effects.len());
         self.effects.retain(|f| match f {
             WindField::Blast(b) => t < b.start + 8.0 * b.decay + b.radius / b.speed.max(1.0),
             WindField::Vortex(v) => t < v.start + v.duration + v.fade,
             WindField::GustFront(g) => t < g.start + 4.0,
             _ => true,
         });
-        fields.extend(self.effects.iter().cloned());
-        self.wind = WindScene { fields };
-        self.packed = self.wind.pack();
+        self.effects.len() != before
     }
 
     /// After a wind edit: the CPU methods read `packed` every step; the GPU ones get it now.
     fn wind_changed(&mut self) {
         self.compose_wind();
         for e in &mut self.entries {
-            if let Err(err) = e.set_wind(self.ctx, &self.wind) {
+            if let Err(err) = e.set_wind(self.ctx, &self.steady, &self.effects) {
                 self.build_error = Some(format!("{err:#}"));
             }
         }
@@ -200,6 +210,9 @@ impl Sim {
     fn build(&self, i: usize) -> Result<Entry> {
         let st = &self.scene.trees[i];
         let mut e = Entry::build(self.ctx, &self.scene, i, st, &self.wind, self.dt)?;
+        if !self.effects.is_empty() {
+            e.set_wind(self.ctx, &self.steady, &self.effects)?;
+        }
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         e.advance(self.ctx, (&self.packed.0, &self.packed.1), self.t, self.dt, 0, true, &mut encoder)?;
         self.ctx.queue.submit([encoder.finish()]);
@@ -343,10 +356,10 @@ impl Sim {
         let steps = ((self.carry / self.dt).floor() as usize).min(MAX_STEPS_PER_FRAME);
         self.carry = (self.carry - steps as f32 * self.dt).clamp(0.0, self.dt);
         self.t += steps as f32 * self.dt;
-        if !self.effects.is_empty() {
+        if self.expire_effects() {
             self.compose_wind();
             for e in &mut self.entries {
-                e.set_wind(self.ctx, &self.wind)?;
+                e.set_wind(self.ctx, &self.steady, &self.effects)?;
             }
         }
         let t1 = Instant::now();
@@ -372,6 +385,7 @@ impl Sim {
                 "instances": e.instances,
                 "simulations": e.simulations,
                 "displacement_m": e.displacement(self.ctx, wind, self.t)?,
+                "simulation_displacements_m": e.group_displacements(self.ctx, wind, self.t)?,
             }));
         }
         Ok(serde_json::json!({
@@ -678,14 +692,19 @@ impl App {
             wall * self.sim.time_scale
         };
         let ctx = self.sim.ctx;
+        // Simulation and meshing go in a submission of their own between the timer's stamps:
+        // submissions complete in order, while passes inside one encoder may overlap a
+        // stamp (lavapipe runs compute asynchronously up to the next barrier).
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        if let Some((t, _)) = &self.timers {
-            t.begin(&mut encoder);
-        }
         let (wind_ms, sim_ms) = self.sim.advance(seconds, &mut encoder)?;
         if let Some((t, _)) = &self.timers {
-            t.end(&mut encoder);
+            t.start(ctx);
         }
+        ctx.queue.submit([encoder.finish()]);
+        if let Some((t, _)) = &self.timers {
+            t.stop(ctx);
+        }
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
         self.sim.frames += 1;
 
         let Some(gfx) = &mut self.gfx else { return Ok(()) };
@@ -1237,7 +1256,8 @@ impl ApplicationHandler for App {
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
         let Some(gfx) = &mut self.gfx else { return };
-        let consumed = gfx.state.on_window_event(&gfx.window, &event).consumed;
+        // Every input goes to egui; the 3D view reads its drags and clicks from there.
+        let _ = gfx.state.on_window_event(&gfx.window, &event);
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
@@ -1251,9 +1271,7 @@ impl ApplicationHandler for App {
                     event_loop.exit();
                 }
             }
-            _ => {
-                let _ = consumed;
-            }
+            _ => {}
         }
     }
 
@@ -1261,5 +1279,29 @@ impl ApplicationHandler for App {
         if let Some(gfx) = &self.gfx {
             gfx.window.request_redraw();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Picking: the view's centre lands on the target when it lies on the ground; a point
+    /// lower in the view lands nearer the camera; the sky hits nothing.
+    #[test]
+    fn clicks_pick_the_ground_under_the_cursor() {
+        let orbit = Orbit { target: Vec3::new(3.0, 0.0, -2.0), yaw: 0.7, pitch: 0.2, distance: 20.0, fov_deg: 45.0 };
+        let centre = orbit.ground_point(0.5, 0.5, 16.0 / 9.0).unwrap();
+        assert!(centre.distance(orbit.target) < 1e-3, "{centre}");
+        let near = orbit.ground_point(0.5, 0.9, 16.0 / 9.0).unwrap();
+        assert!(near.distance(orbit.eye()) < centre.distance(orbit.eye()));
+        assert!(near.y.abs() < 1e-4);
+        assert!(orbit.ground_point(0.5, 0.02, 16.0 / 9.0).is_none(), "the sky is not ground");
+        // The scene's camera round-trips through the orbit.
+        let mut scene = Scene::default_scene();
+        scene.camera.eye = [4.0, 6.0, 30.0];
+        scene.camera.target = [1.0, 2.0, 0.0];
+        let o = Orbit::from_scene(&scene);
+        assert!(o.eye().distance(Vec3::from_array(scene.camera.eye)) < 1e-4, "{}", o.eye());
     }
 }

@@ -663,6 +663,7 @@ target = [0.0, 3.0, 0.0]
 species = "palm"
 method = "akagi"
 backend = "cpu"
+copies = [{ position = [3.0, 0.0, -2.0] }]
 "#;
 
 /// The viewer under Xvfb, driven by a script: the frame shows the tree, a blast placed by
@@ -700,6 +701,11 @@ fn viewer_runs_a_scripted_session_under_xvfb() {
     let (before, after) = (report("before.json"), report("after.json"));
     assert_eq!(displacement(&before), 0.0, "still air leaves the tree at rest");
     assert!(displacement(&after) > 1e-3, "the blast did not move the tree: {after}");
+    // The copy has its own simulation, whose clock runs ahead of the scene's (its phase):
+    // the blast reaches it too.
+    let each = after["trees"][0]["simulation_displacements_m"].as_array().unwrap();
+    assert_eq!(each.len(), 2, "{after}");
+    assert!(each.iter().all(|d| d.as_f64().unwrap() > 1e-3), "a simulation missed the blast: {after}");
     assert_eq!(after["effects"], 1);
     assert!(after["frames"].as_u64().unwrap() > before["frames"].as_u64().unwrap());
 

@@ -8,6 +8,10 @@
 //! and the wait for completion that wall-clock timing includes. Queue submissions run in
 //! order, so the stamps bracket everything submitted between them.
 //!
+//! Compute work is best bracketed by submissions ([`GpuTimer::start`] before, [`GpuTimer::stop`]
+//! after): inside one encoder, a driver may run compute passes with no barrier between them
+//! and the stamp concurrently (lavapipe does), so the stamps can miss them.
+//!
 //! Timestamp queries are an optional feature ([`GpuContext::timestamps`]); without them
 //! [`GpuTimer::new`] returns `None` and callers fall back to wall clock.
 
