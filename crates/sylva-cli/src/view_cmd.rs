@@ -36,9 +36,16 @@ pub struct ViewArgs {
     /// Window height, pixels.
     #[arg(long, default_value_t = 720)]
     pub height: u32,
-    /// Replay the inputs in this file (see `sylva view --help`), then keep running unless it
-    /// ends with `quit`.
-    #[arg(long)]
+    /// Replay the inputs in this file, then keep running unless it ends with `quit`.
+    ///
+    /// One command per line (`#` starts a comment): `frames N` (run N frames of 1/60 s ×
+    /// the time scale), `click U V` (click the view at 0…1 from its top left with the tool),
+    /// `tool blast|vortex|push|none`, `blast X Z` (at ground point x, z), `wind DEG SPEED`
+    /// (an extra constant wind), `method TREE NAME`, `forest TREE N` (N instances),
+    /// `overwrite-scene FILE` (copy FILE over the scene file, as an editor would),
+    /// `screenshot OUT.png` (the 3D view), `report OUT.json` (frames, time, mean stage
+    /// times, every tree's displacement, reload status), `quit`.
+    #[arg(long, verbatim_doc_comment)]
     pub script: Option<PathBuf>,
 }
 
