@@ -36,7 +36,7 @@ enum Anim {
     AkagiCpu(Akagi, Box<AkagiState>),
     AkagiGpu(sylva_gpu::pose::GpuAkagi),
     SkjermoCpu(Skjermo, Box<SkjermoState>),
-    SkjermoGpu(sylva_gpu::pose::GpuSkjermo),
+    SkjermoGpu(Box<Skjermo>, sylva_gpu::pose::GpuSkjermo),
     HsmCpu(Box<Hsm>, Box<HsmState>),
     HsmGpu(Box<Hsm>, sylva_gpu::hsm::GpuHsm),
 }
@@ -66,7 +66,8 @@ impl Anim {
             }
             (MethodName::Skjermo, true) => {
                 let m = Skjermo::new(tree, SkjermoParams::default());
-                Self::SkjermoGpu(sylva_gpu::pose::GpuSkjermo::new(ctx, tree, &m, wind)?)
+                let g = sylva_gpu::pose::GpuSkjermo::new(ctx, tree, &m, wind)?;
+                Self::SkjermoGpu(Box::new(m), g)
             }
             (MethodName::Hsm, false) => {
                 let m = Hsm::new(tree, HsmParams::default())?;
@@ -120,7 +121,7 @@ impl Anim {
                 }
                 Some(Cow::Borrowed(&s.pose))
             }
-            Self::SkjermoGpu(g) => {
+            Self::SkjermoGpu(_, g) => {
                 for _ in 0..steps {
                     g.step(ctx, dt);
                 }
@@ -143,7 +144,7 @@ impl Anim {
                 let pose = match self {
                     Self::ZiomaGpu(_, g) => g.gpu_pose(),
                     Self::AkagiGpu(g) => g.gpu_pose(),
-                    Self::SkjermoGpu(g) => g.gpu_pose(),
+                    Self::SkjermoGpu(_, g) => g.gpu_pose(),
                     Self::HsmGpu(_, g) => g.gpu_pose().context("HSM on the GPU was built without its tree")?,
                     _ => unreachable!("CPU methods return a pose"),
                 };
@@ -285,7 +286,7 @@ impl Anim {
         match self {
             Self::ZiomaGpu(_, g) => g.set_wind(ctx, wind)?,
             Self::AkagiGpu(g) => g.set_wind(ctx, wind)?,
-            Self::SkjermoGpu(g) => g.set_wind(ctx, wind)?,
+            Self::SkjermoGpu(_, g) => g.set_wind(ctx, wind)?,
             Self::HsmGpu(_, g) => g.set_wind(ctx, wind)?,
             _ => {}
         }
@@ -300,7 +301,7 @@ impl Anim {
             Self::AkagiCpu(_, s) => s.pose.clone(),
             Self::AkagiGpu(g) => g.read(ctx)?,
             Self::SkjermoCpu(_, s) => s.pose.clone(),
-            Self::SkjermoGpu(g) => g.read(ctx, &Skjermo::new(tree, SkjermoParams::default()))?,
+            Self::SkjermoGpu(m, g) => g.read(ctx, m)?,
             Self::HsmCpu(m, s) => m.pose(tree, s),
             Self::HsmGpu(_, g) => g.read_pose(ctx)?.context("HSM on the GPU was built without its tree")?,
         })
@@ -313,7 +314,7 @@ impl Anim {
     fn record_deform(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, deform: &GpuDeform) {
         match self {
             Self::SkjermoCpu(_, s) => deform.record_state(ctx, encoder, &s.stems),
-            Self::SkjermoGpu(g) => deform.record(ctx, encoder, g.stems_buffer(), g.state_buffer()),
+            Self::SkjermoGpu(_, g) => deform.record(ctx, encoder, g.stems_buffer(), g.state_buffer()),
             _ => {}
         }
     }
@@ -585,17 +586,16 @@ impl Entry {
         }
     }
 
-    /// HSM's particles and clusters in the first simulation: (particles, cluster centres of
-    /// mass in the tree's frame); `None` for the other methods.
-    pub(crate) fn clusters(&self, ctx: &GpuContext) -> Result<Option<(usize, Vec<Vec3>)>> {
+    /// HSM's cluster centres of mass in the first simulation, in the tree's frame; `None`
+    /// for the other methods.
+    pub(crate) fn clusters(&self, ctx: &GpuContext) -> Result<Option<Vec<Vec3>>> {
         let Drawn::Groups(groups) = &self.drawn else { return Ok(None) };
         let state = match &groups[0].anim {
             Anim::HsmCpu(_, s) => Cow::Borrowed(&**s),
             Anim::HsmGpu(_, g) => Cow::Owned(g.read_state(ctx)?),
             _ => return Ok(None),
         };
-        let centres = state.clusters.iter().map(|c| Vec3::new(c.cm[0], c.cm[1], c.cm[2])).collect();
-        Ok(Some((state.position.len(), centres)))
+        Ok(Some(state.clusters.iter().map(|c| Vec3::new(c.cm[0], c.cm[1], c.cm[2])).collect()))
     }
 
     /// [`Entry::displacement`] of every simulation (phase group), each on its own clock.
@@ -606,22 +606,19 @@ impl Entry {
         t: f32,
     ) -> Result<Vec<f32>> {
         let Drawn::Groups(groups) = &self.drawn else { return Ok(vec![self.displacement(ctx, wind, t)?]) };
-        let rest = &self.tree.segments.start;
-        groups
-            .iter()
-            .map(|g| {
-                let pose = g.anim.pose(ctx, &self.tree, wind, t + g.lead_s)?;
-                Ok(pose.start.iter().zip(rest).map(|(p, r)| p.distance(*r)).sum::<f32>() / rest.len().max(1) as f32)
-            })
-            .collect()
+        groups.iter().map(|g| Ok(self.distance_from_rest(&g.anim.pose(ctx, &self.tree, wind, t + g.lead_s)?))).collect()
     }
 
     /// Mean distance of the segments' joints from rest, m, in the tree's first simulation
     /// (the instance itself): how far the wind has moved it.
     pub(crate) fn displacement(&self, ctx: &GpuContext, wind: (&[RawField], &[RawWave]), t: f32) -> Result<f32> {
-        let pose = self.pose(ctx, wind, t)?;
+        Ok(self.distance_from_rest(&self.pose(ctx, wind, t)?))
+    }
+
+    /// Mean distance of `pose`'s joints from the tree's rest joints, m.
+    fn distance_from_rest(&self, pose: &Pose) -> f32 {
         let rest = &self.tree.segments.start;
-        Ok(pose.start.iter().zip(rest).map(|(p, r)| p.distance(*r)).sum::<f32>() / rest.len().max(1) as f32)
+        pose.start.iter().zip(rest).map(|(p, r)| p.distance(*r)).sum::<f32>() / rest.len().max(1) as f32
     }
 
     /// Whether any phase group pre-rolls further than the scene.

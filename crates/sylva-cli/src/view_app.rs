@@ -1,6 +1,7 @@
 //! The viewer's window: winit events, the egui panel, the 3D view (the renderer's image shown
 //! as an egui texture) and the simulation it drives ([`Sim`]). See [`crate::view_cmd`].
 
+use crate::bench_cmd::write_atomic;
 use crate::scene_runtime::Entry;
 use crate::view_cmd::{Command, Tool, ViewArgs};
 use anyhow::{Context, Result};
@@ -419,13 +420,6 @@ fn ms(d: std::time::Duration) -> f64 {
 
 fn load_wind(scene: &Scene) -> Result<WindScene> {
     WindScene::resolve(&scene.resolve_path(&scene.wind)).with_context(|| format!("{}: field `wind`", scene.file))
-}
-
-/// Writes `bytes` to `path` through a temporary file and a rename.
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))
 }
 
 /// An orbit camera: yaw and pitch about a target, at a distance.
@@ -1220,7 +1214,7 @@ fn overlay(
     }
     if show_clusters {
         for e in &sim.entries {
-            let Ok(Some((_, centres))) = e.clusters(sim.ctx) else { continue };
+            let Ok(Some(centres)) = e.clusters(sim.ctx) else { continue };
             for c in centres {
                 if let Some(p) = project(e.transform.transform_point3(c)) {
                     painter.circle_filled(p, 2.0, egui::Color32::from_rgb(90, 200, 255));
