@@ -1,6 +1,9 @@
 //! Times each stage of hierarchical shape matching on the CPU at Song's largest Table 2 size
-//! (4,975 clusters of Quaking Aspen), or `N` copies of it: `cargo run --release -p sylva-core
-//! --example hsm_stages [N]`; `WIND=<preset or file>` picks the wind (default `gusty`).
+//! (4,975 clusters of Quaking Aspen), or `C` copies of it: `cargo run --release -p sylva-core
+//! --example hsm_stages [C]`; `WIND=<preset or file>` picks the wind (default `gusty`),
+//! `N=<steps>` the number timed (default 50), `ONLY=clusters|fused` times that stage alone
+//! (its data then stays in cache between steps, which the full step does not allow), and
+//! `ONLY=step` whole steps, four-stage against fused.
 
 use std::time::Instant;
 use sylva_core::animate::hsm::*;
@@ -17,31 +20,68 @@ fn main() {
     let l = &h.layout;
     let (f, w) = WindScene::resolve(&std::env::var("WIND").unwrap_or("gusty".into())).unwrap().pack();
     let mut st = h.rest_state();
+    let n: usize = std::env::var("N").map(|s| s.parse().unwrap()).unwrap_or(50);
+    let only = std::env::var("ONLY").unwrap_or_default();
     for _ in 0..20 {
         h.step(&f, &w, &mut st, 1.0 / 60.0);
     }
-    let n = 50;
+
+    if only == "step" {
+        // Whole steps (`Hsm::step`), four-stage and fused, alternating.
+        let four = Hsm::from_layout(&tree, HsmParams { fused: false, ..params }, l.clone());
+        let fused = Hsm::from_layout(&tree, HsmParams { fused: true, ..params }, l.clone());
+        let (mut ta, mut tb) = (0.0, 0.0);
+        for _ in 0..n {
+            let t = Instant::now();
+            four.step(&f, &w, &mut st, 1.0 / 60.0);
+            ta += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            fused.step(&f, &w, &mut st, 1.0 / 60.0);
+            tb += t.elapsed().as_secs_f64();
+        }
+        println!("Hsm::step: four-stage {:.1} steps/s, fused {:.1}", n as f64 / ta, n as f64 / tb);
+        return;
+    }
     let step = h.step_params(1.0, 1.0 / 60.0);
     let (mut t1, mut t3, mut t4, mut tf) = (0.0, 0.0, 0.0, 0.0);
     for _ in 0..n {
+        if only == "fused" {
+            let t = Instant::now();
+            hsm_particles(
+                &l.member_offset,
+                &l.member,
+                &st.clusters,
+                &l.owner,
+                step,
+                &mut st.displacement,
+                &mut st.velocity,
+            );
+            tf += t.elapsed().as_secs_f64();
+            continue;
+        }
+        if only == "clusters" {
+            let t = Instant::now();
+            hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut st.clusters);
+            t1 += t.elapsed().as_secs_f64();
+            continue;
+        }
         let t = Instant::now();
-        hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.position, &l.rest, step, &mut st.clusters);
+        hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut st.clusters);
         t1 += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        hsm_goals(&l.member_offset, &l.member, &l.rest, &st.clusters, &mut st.goal);
+        hsm_goals(&l.member_offset, &l.member, &st.clusters, &mut st.goal);
         t3 += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        hsm_integrate(&l.rest, &l.owner, &st.clusters, &st.goal, step, &mut st.position, &mut st.velocity);
+        hsm_integrate(&l.owner, &st.clusters, &st.goal, step, &mut st.displacement, &mut st.velocity);
         t4 += t.elapsed().as_secs_f64();
         let t = Instant::now();
         hsm_particles(
             &l.member_offset,
             &l.member,
-            &l.rest,
             &st.clusters,
             &l.owner,
             step,
-            &mut st.position,
+            &mut st.displacement,
             &mut st.velocity,
         );
         tf += t.elapsed().as_secs_f64();

@@ -4,7 +4,7 @@ use glam::{DQuat, DVec3, Mat3, Quat, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sylva_core::animate::Pose;
-use sylva_core::animate::hsm::{Hsm, HsmLayout, HsmParams, HsmState, RawHsmClusterState};
+use sylva_core::animate::hsm::{FIXED, Hsm, HsmLayout, HsmParams, HsmState, RawHsmClusterState};
 use sylva_core::cpu::hsm::{extract_rotation, hsm_clusters, hsm_goals};
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::{WindField, WindScene};
@@ -29,7 +29,8 @@ fn random_rotation(rng: &mut ChaCha8Rng, max_angle: f32) -> Quat {
 }
 
 /// Every particle moved by one rigid transform (rotations up to 120°, cold start): each
-/// cluster's goals land on its particles, so the averaged goals equal the positions.
+/// cluster's goals land on its particles, so the averaged goals equal the positions (both
+/// as displacements from rest).
 #[test]
 fn a_rigidly_moved_cluster_has_goals_at_its_positions() {
     let t = tree("stochastic_bush");
@@ -41,18 +42,19 @@ fn a_rigidly_moved_cluster_has_goals_at_its_positions() {
         let r = random_rotation(&mut rng, 2.1);
         let shift = Vec3::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0));
         let mut s = h.rest_state();
-        for p in &mut s.position {
-            let x = r * Vec3::new(p[0], p[1], p[2]) + shift;
-            *p = [x.x, x.y, x.z, p[3]];
+        for (u, x0) in s.displacement.iter_mut().zip(&l.rest) {
+            let x0 = Vec3::new(x0[0], x0[1], x0[2]);
+            let d = (r * x0 + shift) - x0;
+            *u = [d.x, d.y, d.z, u[3]];
         }
         let step = h.step_params(0.0, 1.0 / 240.0);
         // Cold start from R = I: thin clusters converge slowly, so let the warm start carry
         // the extraction over a few calls, as consecutive substeps do.
         for _ in 0..8 {
-            hsm_clusters(&[], &[], &l.info, &l.clusters, &l.slots, &s.position, &l.rest, step, &mut s.clusters);
+            hsm_clusters(&[], &[], &l.info, &l.clusters, &l.slots, &s.displacement, step, &mut s.clusters);
         }
-        hsm_goals(&l.member_offset, &l.member, &l.rest, &s.clusters, &mut s.goal);
-        for (i, (g, x)) in s.goal.iter().zip(&s.position).enumerate() {
+        hsm_goals(&l.member_offset, &l.member, &s.clusters, &mut s.goal);
+        for (i, (g, x)) in s.goal.iter().zip(&s.displacement).enumerate() {
             let d = (Vec3::new(g[0], g[1], g[2]) - Vec3::new(x[0], x[1], x[2])).length();
             assert!(d <= 1e-5, "trial {trial}: particle {i} goal off by {d} m");
         }
@@ -151,7 +153,7 @@ fn still_air_keeps_the_exact_rest_pose() {
         for _ in 0..60 {
             h.step_scene(&WindScene::default(), &mut s, 1.0 / 60.0);
         }
-        assert_eq!(s.position, rest.position, "{name}");
+        assert_eq!(s.displacement, rest.displacement, "{name}");
         assert_eq!(h.pose(&t, &s), Pose::rest(&t), "{name}");
     }
 }
@@ -173,7 +175,7 @@ fn a_100_000_step_storm_stays_stable_and_recovers() {
     for k in 0..100_000 {
         h.step(&f, &w, &mut s, 1.0 / 60.0);
         if k % 5_000 == 0 || k == 99_999 {
-            assert!(s.position.iter().all(|p| p.iter().all(|v| v.is_finite())), "step {k}: NaN");
+            assert!(s.displacement.iter().all(|p| p.iter().all(|v| v.is_finite())), "step {k}: NaN");
             let v = max_speed(&s);
             assert!(v < 80.0, "step {k}: a particle at {v} m/s");
             if let Err(e) = h.pose(&t, &s).check_sound(&t) {
@@ -205,7 +207,7 @@ fn every_preset_survives_a_storm_and_returns_to_rest() {
             h.step(&f, &w, &mut s, 1.0 / 60.0);
             peak = peak.max(s.max_distance(&rest));
         }
-        assert!(s.position.iter().all(|p| p.iter().all(|v| v.is_finite())), "{}: NaN", p.name);
+        assert!(s.displacement.iter().all(|p| p.iter().all(|v| v.is_finite())), "{}: NaN", p.name);
         assert!(max_speed(&s) < 80.0, "{}: a particle at {} m/s", p.name, max_speed(&s));
         assert!(peak > 1e-3, "{}: the storm moved nothing", p.name);
         for _ in 0..1_200 {
@@ -241,12 +243,9 @@ fn hsm_is_identical_on_any_thread_count() {
     };
     let one = run(1);
     assert_eq!(one, run(3));
-    assert_ne!(one.position, h.rest_state().position);
+    assert_ne!(one.displacement, h.rest_state().displacement);
 }
 
-/// The layout is Song's linearised tree: parents before children, children lists that
-/// point back, shared particles listed under every cluster that holds them, the root ring
-/// fixed, and a forest of copies that is the same layout repeated.
 /// The fused particle pass (stages 3 and 4 in one) gives Song's four stages bit for bit.
 #[test]
 fn fused_particle_stages_match_the_four_stages_exactly() {
@@ -264,13 +263,16 @@ fn fused_particle_stages_match_the_four_stages_exactly() {
         s
     };
     let (a, b) = (run(four), run(fused));
-    assert_eq!(a.position, b.position);
+    assert_eq!(a.displacement, b.displacement);
     assert_eq!(a.velocity, b.velocity);
     assert_eq!(a.clusters, b.clusters);
     // Only the four-stage path keeps the goal buffer.
     assert_ne!(a.goal, b.goal);
 }
 
+/// The layout is Song's linearised tree: parents before children, children lists that
+/// point back, shared particles listed under every cluster that holds them, the root ring
+/// fixed, and a forest of copies that is the same layout repeated.
 #[test]
 fn the_layout_links_clusters_head_to_tail() {
     let t = tree("sympodial");
@@ -323,4 +325,37 @@ fn bad_parameters_are_named() {
         let e = Hsm::new(&t, params).unwrap_err().to_string();
         assert!(e.contains(field), "{e}");
     }
+}
+
+/// The state is kept as displacements from rest: fixed particles (velocity w = `FIXED`)
+/// stay exactly at zero through a storm, free ones carry their drag factor unchanged, and
+/// `positions` is the rest plus the displacement.
+#[test]
+fn the_state_holds_displacements_and_fixed_particles_never_move() {
+    let t = tree("stochastic_bush");
+    let h = Hsm::new(&t, HsmParams::default()).unwrap();
+    let l = &h.layout;
+    let wind = storm(30.0);
+    let mut s = h.rest_state();
+    for _ in 0..240 {
+        h.step_scene(&wind, &mut s, 1.0 / 60.0);
+    }
+    let positions = h.positions(&s);
+    assert_eq!(positions.len(), l.particle_count());
+    let mut fixed = 0;
+    for (i, p) in positions.iter().enumerate() {
+        let (u, v) = (s.displacement[i], s.velocity[i]);
+        assert_eq!(u[3], l.mass[i], "particle {i}: mass kept in w");
+        if l.free[i] == 0.0 {
+            fixed += 1;
+            assert_eq!(v[3], FIXED, "particle {i}");
+            assert_eq!(&u[..3], &[0.0; 3], "fixed particle {i} moved");
+        } else {
+            assert_eq!(v[3], l.rest[i][3], "particle {i}: drag factor kept in w");
+        }
+        let want = Vec3::new(l.rest[i][0] + u[0], l.rest[i][1] + u[1], l.rest[i][2] + u[2]);
+        assert_eq!(*p, want);
+    }
+    assert!(fixed > 0, "the root ring is fixed");
+    assert!(s.max_distance(&h.rest_state()) > 1e-3, "the storm moved the bush");
 }

@@ -38,7 +38,6 @@ pub struct GpuHsm {
     info: wgpu::Buffer,
     clusters: wgpu::Buffer,
     slots: wgpu::Buffer,
-    rest: wgpu::Buffer,
     owner: wgpu::Buffer,
     member_offset: wgpu::Buffer,
     member: wgpu::Buffer,
@@ -47,7 +46,7 @@ pub struct GpuHsm {
     steps: wgpu::Buffer,
     steps_capacity: usize,
     step: wgpu::Buffer,
-    position: wgpu::Buffer,
+    displacement: wgpu::Buffer,
     velocity: wgpu::Buffer,
     state: wgpu::Buffer,
     goal: wgpu::Buffer,
@@ -103,7 +102,6 @@ impl GpuHsm {
             info: upload(ctx, "hsm cluster info", &l.info)?,
             clusters: upload(ctx, "hsm clusters", &l.clusters)?,
             slots: upload(ctx, "hsm slots", &l.slots)?,
-            rest: upload(ctx, "hsm rest", &l.rest)?,
             owner: upload(ctx, "hsm owners", &l.owner)?,
             member_offset: upload(ctx, "hsm member offsets", &l.member_offset)?,
             member: upload(ctx, "hsm members", &l.member)?,
@@ -111,7 +109,7 @@ impl GpuHsm {
             steps: upload(ctx, "hsm substeps", &vec![step; method.params.substeps as usize])?,
             steps_capacity: method.params.substeps as usize,
             step: upload(ctx, "hsm step", &[step])?,
-            position: upload(ctx, "hsm positions", &rest_state.position)?,
+            displacement: upload(ctx, "hsm displacements", &rest_state.displacement)?,
             velocity: upload(ctx, "hsm velocities", &rest_state.velocity)?,
             state: upload(ctx, "hsm cluster state", &rest_state.clusters)?,
             goal: output::<[f32; 4]>(ctx, "hsm goals", l.rest.len())?,
@@ -129,7 +127,7 @@ impl GpuHsm {
 
     /// Replaces the GPU state by `state` (for example a settled CPU state).
     pub fn write_state(&mut self, ctx: &GpuContext, state: &HsmState) {
-        ctx.queue.write_buffer(&self.position, 0, bytemuck::cast_slice(&state.position));
+        ctx.queue.write_buffer(&self.displacement, 0, bytemuck::cast_slice(&state.displacement));
         ctx.queue.write_buffer(&self.velocity, 0, bytemuck::cast_slice(&state.velocity));
         ctx.queue.write_buffer(&self.state, 0, bytemuck::cast_slice(&state.clusters));
         ctx.queue.write_buffer(&self.goal, 0, bytemuck::cast_slice(&state.goal));
@@ -189,8 +187,7 @@ impl GpuHsm {
                 &self.info,
                 &self.clusters,
                 &self.slots,
-                &self.position,
-                &self.rest,
+                &self.displacement,
                 &self.step,
                 &self.state,
             ],
@@ -203,11 +200,10 @@ impl GpuHsm {
                 &[
                     &self.member_offset,
                     &self.member,
-                    &self.rest,
                     &self.state,
                     &self.owner,
                     &self.step,
-                    &self.position,
+                    &self.displacement,
                     &self.velocity,
                 ],
                 self.n_particles as u32,
@@ -217,13 +213,13 @@ impl GpuHsm {
         self.goals_kernel.record(
             ctx,
             e,
-            &[&self.member_offset, &self.member, &self.rest, &self.state, &self.goal],
+            &[&self.member_offset, &self.member, &self.state, &self.goal],
             self.n_particles as u32,
         );
         self.integrate_kernel.record(
             ctx,
             e,
-            &[&self.rest, &self.owner, &self.state, &self.goal, &self.step, &self.position, &self.velocity],
+            &[&self.owner, &self.state, &self.goal, &self.step, &self.displacement, &self.velocity],
             self.n_particles as u32,
         );
     }
@@ -244,7 +240,7 @@ impl GpuHsm {
     pub fn read_state(&self, ctx: &GpuContext) -> Result<HsmState, GpuError> {
         use crate::kernel::read_back;
         Ok(HsmState {
-            position: read_back(ctx, &self.position, self.n_particles)?,
+            displacement: read_back(ctx, &self.displacement, self.n_particles)?,
             velocity: read_back(ctx, &self.velocity, self.n_particles)?,
             clusters: read_back::<RawHsmClusterState>(ctx, &self.state, self.n_clusters)?,
             goal: read_back(ctx, &self.goal, self.n_particles)?,

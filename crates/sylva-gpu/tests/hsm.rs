@@ -18,7 +18,7 @@ fn tree(name: &str) -> Tree {
 
 /// Largest particle distance between two states, and whether every value is finite.
 fn worst(a: &HsmState, b: &HsmState) -> f32 {
-    assert!(b.position.iter().flatten().all(|v| v.is_finite()), "non-finite GPU position");
+    assert!(b.displacement.iter().flatten().all(|v| v.is_finite()), "non-finite GPU position");
     a.max_distance(b)
 }
 
@@ -40,7 +40,7 @@ fn hsm_one_substep_matches_from_random_states() {
         let params = HsmParams { substeps: 1, beta, fused, ..Default::default() };
         let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(3000)).unwrap());
         let mut state = h.rest_state();
-        for (p, v) in state.position.iter_mut().zip(state.velocity.iter_mut()) {
+        for (p, v) in state.displacement.iter_mut().zip(state.velocity.iter_mut()) {
             for k in 0..3 {
                 p[k] += rng.random_range(-0.005..0.005);
                 v[k] = rng.random_range(-3.0..3.0);
@@ -145,6 +145,6 @@ fn hsm_on_the_gpu_stays_at_rest_in_still_air() {
     assert_eq!(gpu.read_pose(ctx).unwrap().unwrap(), Pose::rest(&t));
     gpu.advance(ctx, &h, 1.0 / 60.0, 20);
     let g = gpu.read_state(ctx).unwrap();
-    assert_eq!(g.position, h.rest_state().position);
+    assert_eq!(g.displacement, h.rest_state().displacement);
     assert_eq!(gpu.read_pose(ctx).unwrap().unwrap(), Pose::rest(&t));
 }

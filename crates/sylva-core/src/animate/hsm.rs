@@ -21,8 +21,10 @@
 //! information* ([`RawHsmClusterInfo`]: kind, source, particle (slot) offset and count),
 //! *cluster data* ([`RawHsmCluster`]: parent, children, rest centre of mass, Aqq⁻¹; and the
 //! per-step [`RawHsmClusterState`]: current centre of mass, R, the goal transform, the
-//! wind), and *particle data* (position + mass, velocity + free flag, rest position + drag,
-//! owner). A cluster's particles are its run of [`RawHsmSlot`]s (particle index and rest
+//! wind), and *particle data* (displacement from rest + mass, velocity + drag factor (or
+//! [`FIXED`]), rest position, owner). The state is kept as displacements `u = x − x⁰`, not
+//! positions: the stages then never read the rest positions (every per-particle byte
+//! counts, the large layouts are memory-bound), and a particle at rest is exactly zero. A cluster's particles are its run of [`RawHsmSlot`]s (particle index and rest
 //! offset `q = x⁰ − c⁰`); each particle lists the clusters it belongs to with its offset in
 //! each ([`RawHsmMember`]), so a particle's goal is a deterministic gather over its
 //! clusters, never a float atomic.
@@ -417,16 +419,22 @@ pub struct HsmLayout {
     pub max_children: u32,
 }
 
+/// [`HsmState::velocity`]'s w for a fixed particle (free ones carry their drag factor ≥ 0).
+pub const FIXED: f32 = -1.0;
+
 /// Simulation state: structure of arrays, particles in layout order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HsmState {
-    /// Position (xyz) and mass (w) of each particle.
-    pub position: Vec<[f32; 4]>,
-    /// Velocity (xyz, m/s) and free flag (w) of each particle.
+    /// Displacement from the rest position `x − x⁰` (xyz, m) and mass (w, kg) of each
+    /// particle; [`Hsm::positions`] adds the rest back.
+    pub displacement: Vec<[f32; 4]>,
+    /// Velocity (xyz, m/s) of each particle; w is its drag factor `k_d` (1/m, as in
+    /// [`HsmLayout::rest`]), or [`FIXED`] for a fixed particle.
     pub velocity: Vec<[f32; 4]>,
     /// Per-cluster results of the last substep.
     pub clusters: Vec<RawHsmClusterState>,
-    /// Goal (xyz) and ᾱ (w) of each particle from the last substep.
+    /// Goal as a displacement from rest (xyz, m) and ᾱ (w) of each particle from the last
+    /// substep.
     pub goal: Vec<[f32; 4]>,
     /// Simulated time, s.
     pub time: f32,
@@ -435,7 +443,7 @@ pub struct HsmState {
 impl HsmState {
     /// Kinetic energy ½ Σ m v², J.
     pub fn kinetic_energy(&self) -> f64 {
-        self.position
+        self.displacement
             .iter()
             .zip(&self.velocity)
             .map(|(p, v)| 0.5 * p[3] as f64 * (Vec3::new(v[0], v[1], v[2]).length_squared() as f64))
@@ -444,9 +452,9 @@ impl HsmState {
 
     /// Largest distance of any particle from the same particle in `other`, m.
     pub fn max_distance(&self, other: &HsmState) -> f32 {
-        self.position
+        self.displacement
             .iter()
-            .zip(&other.position)
+            .zip(&other.displacement)
             .map(|(a, b)| (Vec3::new(a[0], a[1], a[2]) - Vec3::new(b[0], b[1], b[2])).length())
             .fold(0.0, f32::max)
     }
@@ -803,17 +811,18 @@ impl HsmLayout {
     /// in one pass.
     pub fn bytes_per_step(&self, fused: bool) -> usize {
         let (c, p, s, m) = (self.info.len(), self.rest.len(), self.slots.len(), self.member.len());
-        // Stage 1: info, clusters, cluster state (r/w), slots, position and rest per slot.
-        let stage1 = c * (16 + 80 + 2 * 96) + s * (16 + 16 + 16);
-        // Stage 3: offsets, rest, goal written; per member: the record (q, cluster), the
+        // Stage 1: info, clusters, cluster state (r/w); per slot the record and the
+        // particle's displacement + mass.
+        let stage1 = c * (16 + 80 + 2 * 96) + s * (16 + 16);
+        // Stage 3: offsets, goal written; per member: the record (q, cluster), the
         // cluster's transform and α.
         let members = m * (16 + 52);
-        let stage3 = p * (4 + 16 + 16) + members;
-        // Stage 4: position, velocity (r/w), rest, owner, goal, owner's wind.
-        let stage4 = p * (2 * 16 + 2 * 16 + 16 + 4 + 16 + 16);
+        let stage3 = p * (4 + 16) + members;
+        // Stage 4: displacement, velocity (r/w), owner, goal, owner's wind.
+        let stage4 = p * (2 * 16 + 2 * 16 + 4 + 16 + 16);
         if fused {
-            // One pass: no goal written or read, rest read once.
-            p * (4 + 2 * 16 + 2 * 16 + 16 + 4 + 16) + members + stage1
+            // One pass: no goal written or read.
+            p * (4 + 2 * 16 + 2 * 16 + 4 + 16) + members + stage1
         } else {
             stage1 + stage3 + stage4
         }
@@ -847,10 +856,15 @@ impl Hsm {
     pub fn rest_state(&self) -> HsmState {
         let l = &self.layout;
         HsmState {
-            position: l.rest.iter().zip(&l.mass).map(|(r, m)| [r[0], r[1], r[2], *m]).collect(),
-            velocity: l.free.iter().map(|f| [0.0, 0.0, 0.0, *f]).collect(),
+            displacement: l.mass.iter().map(|m| [0.0, 0.0, 0.0, *m]).collect(),
+            velocity: l
+                .rest
+                .iter()
+                .zip(&l.free)
+                .map(|(r, f)| [0.0, 0.0, 0.0, if *f > 0.0 { r[3] } else { FIXED }])
+                .collect(),
             clusters: l.clusters.iter().map(RawHsmClusterState::rest).collect(),
-            goal: l.rest.iter().map(|r| [r[0], r[1], r[2], 0.0]).collect(),
+            goal: vec![[0.0; 4]; l.rest.len()],
             time: 0.0,
         }
     }
@@ -875,39 +889,20 @@ impl Hsm {
     pub fn substep(&self, fields: &[RawField], waves: &[RawWave], state: &mut HsmState, h: f32) {
         let l = &self.layout;
         let step = self.step_params(state.time + h, h);
-        hsm_clusters(
-            fields,
-            waves,
-            &l.info,
-            &l.clusters,
-            &l.slots,
-            &state.position,
-            &l.rest,
-            step,
-            &mut state.clusters,
-        );
+        hsm_clusters(fields, waves, &l.info, &l.clusters, &l.slots, &state.displacement, step, &mut state.clusters);
         if self.params.fused {
             hsm_particles(
                 &l.member_offset,
                 &l.member,
-                &l.rest,
                 &state.clusters,
                 &l.owner,
                 step,
-                &mut state.position,
+                &mut state.displacement,
                 &mut state.velocity,
             );
         } else {
-            hsm_goals(&l.member_offset, &l.member, &l.rest, &state.clusters, &mut state.goal);
-            hsm_integrate(
-                &l.rest,
-                &l.owner,
-                &state.clusters,
-                &state.goal,
-                step,
-                &mut state.position,
-                &mut state.velocity,
-            );
+            hsm_goals(&l.member_offset, &l.member, &state.clusters, &mut state.goal);
+            hsm_integrate(&l.owner, &state.clusters, &state.goal, step, &mut state.displacement, &mut state.velocity);
         }
         state.time = step.time;
     }
@@ -939,6 +934,16 @@ impl Hsm {
             }
         }
         max_steps
+    }
+
+    /// Particle positions `x⁰ + u` of `state`, m.
+    pub fn positions(&self, state: &HsmState) -> Vec<Vec3> {
+        self.layout
+            .rest
+            .iter()
+            .zip(&state.displacement)
+            .map(|(r, u)| Vec3::new(r[0] + u[0], r[1] + u[1], r[2] + u[2]))
+            .collect()
     }
 
     /// Accumulated rotations of the pose seam: each segment's cluster R (identity for

@@ -13,101 +13,22 @@
 //!   still reproduces the rest curves bit for bit;
 //! * `p2_weight^exponent` is computed once per step, not once per stem.
 //!
-//! Wind fields of the paper's kind (constant and sum of sines, eqs. 11–14) are evaluated on
-//! all eight lanes at once (a polynomial sine; integer sharpness by repeated multiplication);
-//! other field kinds fall back to the scalar `wind_at` per lane. Results agree with the
+//! The wind is sampled on all eight lanes at once ([`crate::wind::lanes`]: a polynomial sine,
+//! integer sharpness by repeated multiplication). Results agree with the
 //! reference to rounding (tested), and are identical whatever the thread count: every group is
 //! computed by the same instructions whichever thread runs it.
 
 use super::skjermo::{RawSkjermoStem, bezier_d};
-use crate::cpu::wind_sample::field_at;
 use crate::model::NONE;
-use crate::wind::raw::{RawField, RawWave, kind};
+pub use crate::wind::lanes::LANES;
+use crate::wind::lanes::{V3, wind_lanes};
+use crate::wind::raw::{RawField, RawWave};
 use glam::Vec3;
 use rayon::prelude::*;
+use std::ops::{Add, Sub};
 use wide::{CmpGt, f32x8};
 
-/// Stems per lane group.
-pub const LANES: usize = 8;
-
 type V = f32x8;
-
-/// Three lanes of eight: x, y and z of eight vectors.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct V3 {
-    /// x of each lane.
-    pub x: V,
-    /// y of each lane.
-    pub y: V,
-    /// z of each lane.
-    pub z: V,
-}
-
-impl V3 {
-    const ZERO: Self = Self { x: V::ZERO, y: V::ZERO, z: V::ZERO };
-    #[inline(always)]
-    fn splat(v: Vec3) -> Self {
-        Self { x: V::splat(v.x), y: V::splat(v.y), z: V::splat(v.z) }
-    }
-    #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        Self { x: self.x + o.x, y: self.y + o.y, z: self.z + o.z }
-    }
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        Self { x: self.x - o.x, y: self.y - o.y, z: self.z - o.z }
-    }
-    #[inline(always)]
-    fn scale(self, s: V) -> Self {
-        Self { x: self.x * s, y: self.y * s, z: self.z * s }
-    }
-    #[inline(always)]
-    fn dot(self, o: Self) -> V {
-        self.x * o.x + self.y * o.y + self.z * o.z
-    }
-    #[inline(always)]
-    fn cross(self, o: Self) -> Self {
-        Self { x: self.y * o.z - o.y * self.z, y: self.z * o.x - o.z * self.x, z: self.x * o.y - o.x * self.y }
-    }
-    #[inline(always)]
-    fn length(self) -> V {
-        self.dot(self).sqrt()
-    }
-    #[inline(always)]
-    fn select(mask: V, a: Self, b: Self) -> Self {
-        Self { x: mask.blend(a.x, b.x), y: mask.blend(a.y, b.y), z: mask.blend(a.z, b.z) }
-    }
-    /// `axis_or`: normalised where longer than 1e-6, else `fallback`.
-    #[inline(always)]
-    fn axis_or(self, fallback: Self) -> Self {
-        let l = self.length();
-        let ok = l.cmp_gt(V::splat(1e-6));
-        let safe = ok.blend(l, V::ONE);
-        // One reciprocal, as `animate::skjermo::unit_or`: the same rounding as the reference,
-        // so the rest frames it builds are reproduced bit for bit.
-        Self::select(ok, self.scale(V::ONE / safe), fallback)
-    }
-    /// glam's `normalize_or_zero`.
-    #[inline(always)]
-    fn normalize_or_zero(self) -> Self {
-        let l = self.length();
-        let ok = l.cmp_gt(V::ZERO) & l.is_finite();
-        let safe = ok.blend(l, V::ONE);
-        Self::select(ok, self.scale(V::ONE / safe), Self::ZERO)
-    }
-    /// glam's `any_orthogonal_vector`.
-    #[inline(always)]
-    fn any_orthogonal(self) -> Self {
-        let m = self.x.abs().cmp_gt(self.y.abs());
-        Self { x: m.blend(-self.z, V::ZERO), y: m.blend(V::ZERO, self.z), z: m.blend(self.x, -self.y) }
-    }
-    fn lane(&self, l: usize) -> Vec3 {
-        Vec3::new(self.x.as_array_ref()[l], self.y.as_array_ref()[l], self.z.as_array_ref()[l])
-    }
-    fn from_lanes(v: [Vec3; LANES]) -> Self {
-        Self { x: V::from(v.map(|a| a.x)), y: V::from(v.map(|a| a.y)), z: V::from(v.map(|a| a.z)) }
-    }
-}
 
 /// The attachment frame `[T, N, B]` from a curve tangent and an orientation vector, as
 /// `animate::skjermo::frame`.
@@ -233,69 +154,6 @@ pub fn build(stems: &[RawSkjermoStem], rest_orient: &[[f32; 4]]) -> (Vec<StemLan
     (lanes, state)
 }
 
-/// Sine on eight lanes: reduced to [−π, π] by whole turns, then an odd degree-11 polynomial
-/// fitted to sine by least squares on Chebyshev nodes (absolute error < 2e-6 on [−π, π]; the reference's `sin`
-/// is correctly rounded, so the two paths differ by that much at most).
-#[inline(always)]
-fn sin(x: V) -> V {
-    let turns = (x * V::splat(std::f32::consts::FRAC_1_PI * 0.5)).round();
-    // Two-part 2π so the reduction stays exact for the arguments the wind produces.
-    let r = x - turns * V::splat(6.28125) - turns * V::splat(0.001_935_307_2);
-    let r2 = r * r;
-    let p = V::splat(-2.053_034_2e-8) * r2 + V::splat(2.704_617_4e-6);
-    let p = p * r2 + V::splat(-1.981_395_8e-4);
-    let p = p * r2 + V::splat(8.332_666e-3);
-    let p = p * r2 + V::splat(-1.666_661e-1);
-    r + r * r2 * p
-}
-
-/// `x^k` for a small integer `k ≥ 0` by repeated squaring.
-fn powi(mut x: V, mut k: u32) -> V {
-    let mut r = V::ONE;
-    while k > 0 {
-        if k & 1 == 1 {
-            r *= x;
-        }
-        x *= x;
-        k >>= 1;
-    }
-    r
-}
-
-/// The wind scene at eight points (as `cpu::wind_sample::wind_at`).
-#[inline(always)]
-fn wind_lanes(fields: &[RawField], waves: &[RawWave], p: V3, t: f32) -> V3 {
-    let mut v = V3::ZERO;
-    for f in fields {
-        match f.kind {
-            kind::CONSTANT => v = v.add(V3::splat(Vec3::new(f.a[0], f.a[1], f.a[2]))),
-            kind::SUM_OF_SINES => {
-                let (sharp, mode) = (f.a[0], f.a[1]);
-                let int_sharp = (sharp.fract() == 0.0 && (0.0..=16.0).contains(&sharp)).then_some(sharp as u32);
-                for w in &waves[f.wave_offset as usize..(f.wave_offset + f.wave_count) as usize] {
-                    let th = p.x * w.k[0] + p.y * w.k[1] + p.z * w.k[2] + V::splat(w.k[3] * t);
-                    let s = sin(th);
-                    let h = if mode < 0.5 {
-                        s
-                    } else {
-                        let base = (s + V::ONE) * V::splat(0.5);
-                        match int_sharp {
-                            Some(k) => powi(base, k),
-                            None => base.pow_f32x8(V::splat(sharp)),
-                        }
-                    };
-                    v = v.add(V3::splat(Vec3::new(w.dir[0], w.dir[1], w.dir[2])).scale(h));
-                }
-            }
-            _ => {
-                let per: [Vec3; LANES] = std::array::from_fn(|l| field_at(f, waves, p.lane(l), t));
-                v = v.add(V3::from_lanes(per));
-            }
-        }
-    }
-    v
-}
-
 /// Gathers the parents' previous state for the eight lanes of a group (a trunk or padding
 /// lane sees no displacement and the orientation vector `X`, as the reference's trunk frame).
 #[inline(always)]
@@ -377,30 +235,4 @@ pub fn step(
         d[3] = d[3].add(c2.add(c3));
         *out = StateLanes { delta: d, orient: f_now[1] };
     });
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn lane_sine_is_within_its_stated_error() {
-        let mut worst = 0.0f32;
-        for i in -200_000..=200_000 {
-            let x = i as f32 * 0.05;
-            let got = sin(V::splat(x)).as_array_ref()[0];
-            worst = worst.max((got - x.sin()).abs());
-        }
-        // 2e-6 from the polynomial on [−π, π]; the reduction adds the rounding of x itself.
-        assert!(worst < 4e-6, "worst error {worst}");
-    }
-
-    #[test]
-    fn integer_powers_match_powf() {
-        for k in 0..=16u32 {
-            let x = 0.93f32;
-            let got = powi(V::splat(x), k).as_array_ref()[0];
-            assert!((got - x.powf(k as f32)).abs() <= 1e-6, "{k}: {got}");
-        }
-    }
 }

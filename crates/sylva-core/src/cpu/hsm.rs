@@ -6,8 +6,8 @@
 use crate::animate::hsm::{
     RawHsmCluster, RawHsmClusterInfo, RawHsmClusterState, RawHsmMember, RawHsmSlot, RawHsmStep, kind,
 };
-use crate::cpu::wind_sample::wind_at;
 use crate::model::NONE;
+use crate::wind::lanes::{LANES as WIND_LANES, V3, wind_lanes};
 use crate::wind::raw::{RawField, RawWave};
 use glam::{Mat3, Quat, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
@@ -41,11 +41,24 @@ pub fn extract_rotation(a: Mat3, q: Quat, iterations: u32) -> Quat {
     q
 }
 
+/// One slot's terms of a cluster's sums from the particle's displacement `x` (w = mass):
+/// `[m u, m d q.x, m d q.y, m d q.z]` with `d = u + q = x − c⁰` (so Apq stays exactly
+/// symmetric when u = 0). WGSL: the slot loop of `hsm_clusters.wgsl`.
+#[inline(always)]
+fn slot_terms(x: [f32; 4], s: &RawHsmSlot) -> [Vec3A; 4] {
+    let m = x[3];
+    let u = a3(x);
+    let q = Vec3A::from_array(s.q);
+    let d = u + q;
+    [u * m, (d * q.x) * m, (d * q.y) * m, (d * q.z) * m]
+}
+
 /// Stage 1, per cluster: centre of mass, Apq, R, the goal transform, α and the wind at the
-/// centre. Sums run over displacements from rest `u = x − x⁰`, so a cluster at rest has
-/// exactly zero shift and an exactly symmetric Apq (R = I): still air keeps the rest bit
-/// for bit. Bindings: 0 fields, 1 waves, 2 cluster info, 3 clusters, 4 slots, 5 positions,
-/// 6 rest positions, 7 step, 8 cluster state (read for R's warm start, written).
+/// centre. Sums run over the particles' displacements from rest `u = x − x⁰` (the state
+/// itself), so a cluster at rest has exactly zero shift and an exactly symmetric Apq
+/// (R = I): still air keeps the rest bit for bit. Bindings: 0 fields, 1 waves, 2 cluster
+/// info, 3 clusters, 4 slots, 5 displacements (w = mass), 6 step, 7 cluster state (read
+/// for R's warm start, written).
 #[allow(clippy::too_many_arguments)]
 pub fn hsm_clusters(
     fields: &[RawField],
@@ -53,36 +66,33 @@ pub fn hsm_clusters(
     info: &[RawHsmClusterInfo],
     clusters: &[RawHsmCluster],
     slots: &[RawHsmSlot],
-    position: &[[f32; 4]],
-    rest: &[[f32; 4]],
+    displacement: &[[f32; 4]],
     step: RawHsmStep,
     state: &mut [RawHsmClusterState],
 ) {
     // Scratch lanes, one set per rayon job (not per cluster: only the lanes a cluster uses
-    // are reset).
-    let scratch = || vec![[Vec3A::ZERO; 4]; LANES];
+    // are written).
+    let scratch = || Box::new([[Vec3A::ZERO; 4]; LANES]);
     state.par_iter_mut().enumerate().with_min_len(64).for_each_init(scratch, |lane, (c, st)| {
         let inf = info[c];
         let cl = &clusters[c];
         let c0 = v3(cl.rest_cm);
-        // Lane sums [Σ m u, Apq columns] of the workgroup's invocations (lane j mod 64 adds
-        // slot j, starting from zero); lanes past the slot count stay zero, so the reduction
-        // below needs only the next power of two.
+        // Lane sums [Σ m u, Apq columns] of the workgroup's invocations: lane j mod 64 adds
+        // slot j to zero, then slot j + 64, …; lanes past the slot count stay zero, so the
+        // reduction below needs only the next power of two.
         let run = &slots[inf.slot_offset as usize..(inf.slot_offset + inf.slot_count) as usize];
         let width = run.len().clamp(1, LANES).next_power_of_two();
-        lane[..width].fill([Vec3A::ZERO; 4]);
-        for (j, s) in run.iter().enumerate() {
-            let x = position[s.particle as usize];
-            let m = x[3];
-            let u = a3(x) - a3(rest[s.particle as usize]);
-            let q = Vec3A::from_array(s.q);
-            // d = x − c⁰ = u + q; (d qⱼ) m keeps Apq symmetric when u = 0.
-            let d = u + q;
+        let (first, rest) = run.split_at(run.len().min(LANES));
+        for (l, s) in lane.iter_mut().zip(first) {
+            // 0 + v as on the GPU (it maps −0 to +0).
+            *l = slot_terms(displacement[s.particle as usize], s).map(|v| Vec3A::ZERO + v);
+        }
+        lane[first.len()..width].fill([Vec3A::ZERO; 4]);
+        for (j, s) in rest.iter().enumerate() {
             let l = &mut lane[j % LANES];
-            l[0] += u * m;
-            l[1] += (d * q.x) * m;
-            l[2] += (d * q.y) * m;
-            l[3] += (d * q.z) * m;
+            for (x, v) in l.iter_mut().zip(slot_terms(displacement[s.particle as usize], s)) {
+                *x += v;
+            }
         }
         let mut stride = width / 2;
         while stride > 0 {
@@ -112,27 +122,48 @@ pub fn hsm_clusters(
             }
         }
         let alpha = (cl.rest_cm[3] * step.dt * step.dt).min(1.0);
-        // A leaf feels the wind sampled for its segment (stage 4 reads it there).
-        let u = if inf.kind == kind::LEAF { Vec3::ZERO } else { wind_at(fields, waves, cm, step.time) };
         st.cm = [cm.x, cm.y, cm.z, alpha];
         st.rotation = q.to_array();
         st.transform =
             [t.x_axis.extend(shift.x).into(), t.y_axis.extend(shift.y).into(), t.z_axis.extend(shift.z).into()];
-        st.wind = [u.x, u.y, u.z, 0.0];
+        st.wind = [0.0; 4];
+    });
+    cluster_wind(fields, waves, info, step.time, state);
+}
+
+/// The wind at the centres of the segment clusters (a leaf feels the wind sampled for its
+/// segment: stage 4 reads it there, and a leaf cluster's stays zero). The WGSL samples it in
+/// the cluster's own invocation; here it is sampled eight centres at a time
+/// ([`crate::wind::lanes`]), in fixed groups, so the result does not depend on the threads.
+fn cluster_wind(
+    fields: &[RawField],
+    waves: &[RawWave],
+    info: &[RawHsmClusterInfo],
+    time: f32,
+    state: &mut [RawHsmClusterState],
+) {
+    if fields.is_empty() {
+        return;
+    }
+    const CHUNK: usize = 256;
+    state.par_chunks_mut(CHUNK).enumerate().for_each(|(k, chunk)| {
+        let kinds = &info[k * CHUNK..k * CHUNK + chunk.len()];
+        let segments: Vec<usize> = (0..chunk.len()).filter(|&j| kinds[j].kind != kind::LEAF).collect();
+        for group in segments.chunks(WIND_LANES) {
+            let centre = |l: usize| v3(chunk[group[l.min(group.len() - 1)]].cm);
+            let u = wind_lanes(fields, waves, V3::from_lanes(std::array::from_fn(centre)), time);
+            for (l, &j) in group.iter().enumerate() {
+                let w = u.lane(l);
+                chunk[j].wind = [w.x, w.y, w.z, 0.0];
+            }
+        }
     });
 }
 
-/// A particle's goal (xyz) and ᾱ (w): the α-weighted mean over its clusters (see
-/// [`hsm_goals`]). WGSL: the loop of `hsm_goals.wgsl` and `hsm_particles.wgsl` around
-/// `hsm_goal_displacement`.
+/// A particle's goal as a displacement from rest (xyz) and ᾱ (w): the α-weighted mean over
+/// its clusters (see [`hsm_goals`]). WGSL: `hsm_particle_goal` in `hsm_gather.wgsl`.
 #[inline(always)]
-fn particle_goal(
-    i: usize,
-    member_offset: &[u32],
-    member: &[RawHsmMember],
-    rest: &[[f32; 4]],
-    state: &[RawHsmClusterState],
-) -> [f32; 4] {
+fn particle_goal(i: usize, member_offset: &[u32], member: &[RawHsmMember], state: &[RawHsmClusterState]) -> [f32; 4] {
     let lo = member_offset[i] as usize;
     let hi = member_offset[i + 1] as usize;
     let mut sum = Vec3A::ZERO;
@@ -142,8 +173,7 @@ fn particle_goal(
         sum += goal_displacement(st, Vec3A::from_array(m.q)) * st.cm[3];
         wsum += st.cm[3];
     }
-    let x0 = a3(rest[i]);
-    if wsum > 0.0 { with_xyz(x0 + sum / wsum, wsum.min(1.0)) } else { with_xyz(x0, 0.0) }
+    if wsum > 0.0 { with_xyz(sum / wsum, wsum.min(1.0)) } else { [0.0; 4] }
 }
 
 /// A cluster's goal for rest offset `q`, as a displacement from rest: `(T q − q) + (c − c⁰)`.
@@ -156,13 +186,15 @@ fn goal_displacement(st: &RawHsmClusterState, q: Vec3A) -> Vec3A {
     (tq - q) + shift
 }
 
-/// A free particle's new velocity: the pull toward goal `g` (w = ᾱ), gravity, semi-implicit
-/// drag toward `wind` with drag factor `kd`, damping. WGSL: `hsm_velocity`.
+/// A free particle's new velocity: the pull toward goal `g` (w = ᾱ) from `u` (both
+/// displacements from rest, so `g − u` is the goal minus the position), gravity,
+/// semi-implicit drag toward `wind` with drag factor `kd`, damping. WGSL: `hsm_velocity`.
 #[inline(always)]
-fn particle_velocity(v: Vec3A, g: [f32; 4], p: Vec3A, wind: Vec3A, kd: f32, step: &RawHsmStep) -> Vec3A {
+fn particle_velocity(v: Vec3A, g: [f32; 4], u: Vec3A, wind: Vec3A, kd: f32, step: &RawHsmStep) -> Vec3A {
     let h = step.dt;
     let gravity = Vec3A::from_array([step.gravity[0], step.gravity[1], step.gravity[2]]);
-    let mut vel = v + (a3(g) - p) * (g[3] / h) + gravity * ((1.0 - step.gravity[3]) * h);
+    // ᾱ / h as ᾱ · (1 / h): one division per step, not per particle.
+    let mut vel = v + (a3(g) - u) * (g[3] * (1.0 / h)) + gravity * ((1.0 - step.gravity[3]) * h);
     let rel = wind - vel;
     let s = h * kd * rel.length();
     vel += rel * (s / (1.0 + s));
@@ -182,35 +214,28 @@ fn with_xyz(v: Vec3A, w: f32) -> [f32; 4] {
 }
 
 /// Stage 3, per particle: the α-weighted mean of its clusters' goals `T_c q + c_c`, and
-/// `ᾱ = min(1, Σ α_c)`. Goals are formed as displacements from rest, `x⁰ + (T q − q) + (c − c⁰)`,
-/// so a cluster at rest gives exactly `x⁰`. Bindings: 0 member offsets, 1 members, 2 rest
-/// positions, 3 cluster state, 4 goals.
-pub fn hsm_goals(
-    member_offset: &[u32],
-    member: &[RawHsmMember],
-    rest: &[[f32; 4]],
-    state: &[RawHsmClusterState],
-    goal: &mut [[f32; 4]],
-) {
+/// `ᾱ = min(1, Σ α_c)`. Goals are kept as displacements from rest, `(T q − q) + (c − c⁰)`,
+/// so a cluster at rest gives exactly zero. Bindings: 0 member offsets, 1 members,
+/// 2 cluster state, 3 goals.
+pub fn hsm_goals(member_offset: &[u32], member: &[RawHsmMember], state: &[RawHsmClusterState], goal: &mut [[f32; 4]]) {
     goal.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, g)| {
-        *g = particle_goal(i, member_offset, member, rest, state);
+        *g = particle_goal(i, member_offset, member, state);
     });
 }
 
 /// Stage 4, per particle: shape-matching pull, gravity (balanced by the support of a
-/// prestressed tree), drag toward the wind of its `owner` cluster,
-/// damping, then the position. Bindings: 0 rest (w = drag factor), 1 owners, 2 cluster
-/// state, 3 goals, 4 step, 5 positions, 6 velocities.
+/// prestressed tree), drag toward the wind of its `owner` cluster, damping, then the
+/// displacement. Bindings: 0 owners, 1 cluster state, 2 goals, 3 step, 4 displacements,
+/// 5 velocities (w = drag factor, negative for a fixed particle).
 pub fn hsm_integrate(
-    rest: &[[f32; 4]],
     owner: &[u32],
     state: &[RawHsmClusterState],
     goal: &[[f32; 4]],
     step: RawHsmStep,
-    position: &mut [[f32; 4]],
+    displacement: &mut [[f32; 4]],
     velocity: &mut [[f32; 4]],
 ) {
-    integrate_free(rest, owner, state, step, position, velocity, |i| goal[i]);
+    integrate_free(owner, state, step, displacement, velocity, |i| goal[i]);
 }
 
 /// Stages 3 and 4 in one pass per particle: its goal, gathered from its clusters, is read by
@@ -218,44 +243,47 @@ pub fn hsm_integrate(
 /// buffer (Song needs a synchronisation between the two because his goals are scattered
 /// from the clusters). The same operations as [`hsm_goals`] then [`hsm_integrate`], so the
 /// result is bit for bit theirs without the goal buffer's write and re-read. Bindings:
-/// 0 member offsets, 1 members, 2 rest (w = drag factor), 3 cluster state, 4 owners,
-/// 5 step, 6 positions, 7 velocities.
-#[allow(clippy::too_many_arguments)]
+/// 0 member offsets, 1 members, 2 cluster state, 3 owners, 4 step, 5 displacements,
+/// 6 velocities.
 pub fn hsm_particles(
     member_offset: &[u32],
     member: &[RawHsmMember],
-    rest: &[[f32; 4]],
     state: &[RawHsmClusterState],
     owner: &[u32],
     step: RawHsmStep,
-    position: &mut [[f32; 4]],
+    displacement: &mut [[f32; 4]],
     velocity: &mut [[f32; 4]],
 ) {
-    integrate_free(rest, owner, state, step, position, velocity, |i| {
-        particle_goal(i, member_offset, member, rest, state)
-    });
+    integrate_free(owner, state, step, displacement, velocity, |i| particle_goal(i, member_offset, member, state));
 }
 
 /// Stage 4 over every free particle, its goal from `goal_of` (read from the goal buffer,
 /// or gathered in place by the fused pass).
 #[inline(always)]
 fn integrate_free(
-    rest: &[[f32; 4]],
     owner: &[u32],
     state: &[RawHsmClusterState],
     step: RawHsmStep,
-    position: &mut [[f32; 4]],
+    displacement: &mut [[f32; 4]],
     velocity: &mut [[f32; 4]],
     goal_of: impl Fn(usize) -> [f32; 4] + Sync,
 ) {
-    position.par_iter_mut().zip(velocity.par_iter_mut()).enumerate().with_min_len(256).for_each(|(i, (x, v))| {
-        if v[3] == 0.0 {
-            return; // fixed
+    // Chunks with a plain loop inside: the per-particle work is small, so a call per
+    // particle would cost as much as the work.
+    const CHUNK: usize = 1024;
+    displacement.par_chunks_mut(CHUNK).zip(velocity.par_chunks_mut(CHUNK)).enumerate().for_each(|(k, (xs, vs))| {
+        let base = k * CHUNK;
+        let owners = &owner[base..base + xs.len()];
+        for (i, ((x, v), o)) in xs.iter_mut().zip(vs.iter_mut()).zip(owners).enumerate() {
+            let kd = v[3];
+            if kd < 0.0 {
+                continue; // fixed
+            }
+            let u = a3(*x);
+            let vel = particle_velocity(a3(*v), goal_of(base + i), u, a3(state[*o as usize].wind), kd, &step);
+            *x = with_xyz(u + vel * step.dt, x[3]);
+            *v = with_xyz(vel, kd);
         }
-        let p = a3(*x);
-        let vel = particle_velocity(a3(*v), goal_of(i), p, a3(state[owner[i] as usize].wind), rest[i][3], &step);
-        *x = with_xyz(p + vel * step.dt, x[3]);
-        *v = with_xyz(vel, v[3]);
     });
 }
 

@@ -17,6 +17,7 @@
 //! Every field is evaluated through its packed form ([`raw`]) by [`crate::cpu::wind_sample`],
 //! the CPU twin of the WGSL kernel, so the friendly API and the GPU share one definition.
 
+pub mod lanes;
 pub mod raw;
 pub mod trunk;
 

@@ -99,11 +99,12 @@ fn hsm_goal_displacement(st: HsmClusterState, q: vec3<f32>) -> vec3<f32> {
     return (tq - q) + shift;
 }
 
-// A free particle's new velocity: pull toward goal g (w = ᾱ), gravity, semi-implicit drag
-// toward `wind` with drag factor kd, damping. Twin: particle_velocity.
-fn hsm_velocity(v: vec3<f32>, g: vec4<f32>, p: vec3<f32>, wind: vec3<f32>, kd: f32, step: HsmStep) -> vec3<f32> {
+// A free particle's new velocity: pull toward goal g (w = ᾱ) from u (both displacements
+// from rest), gravity, semi-implicit drag toward `wind` with drag factor kd, damping.
+// Twin: particle_velocity.
+fn hsm_velocity(v: vec3<f32>, g: vec4<f32>, u: vec3<f32>, wind: vec3<f32>, kd: f32, step: HsmStep) -> vec3<f32> {
     let h = step.dt;
-    var vel = v + (g.xyz - p) * (g.w / h) + step.gravity.xyz * ((1.0 - step.gravity.w) * h);
+    var vel = v + (g.xyz - u) * (g.w * (1.0 / h)) + step.gravity.xyz * ((1.0 - step.gravity.w) * h);
     let rel = wind - vel;
     let s = h * kd * length(rel);
     vel += rel * (s / (1.0 + s));

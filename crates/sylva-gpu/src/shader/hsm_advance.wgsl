@@ -1,16 +1,18 @@
 // Stage 4's particle update, shared by hsm_integrate and hsm_particles: shape-matching pull
 // toward `goal`, gravity (balanced when prestressed), semi-implicit drag toward the owner
-// cluster's wind, damping, then the position. Fixed particles (velocity w = 0) stay.
-// Reads the kernel's `rest`, `owner`, `state`, `step`; writes `position`, `velocity`.
-// CPU twin: sylva_core::cpu::hsm (the integration loop shared by both passes).
+// cluster's wind, damping, then the displacement. The velocity's w is the drag factor;
+// fixed particles (w < 0) stay. Reads the kernel's `owner`, `state`, `step`; writes
+// `displacement`, `velocity`. CPU twin: sylva_core::cpu::hsm (the integration loop shared
+// by both passes).
 
 fn hsm_advance(i: u32, goal: vec4<f32>) {
     let v0 = velocity[i];
-    if (v0.w == 0.0) {
+    let kd = v0.w;
+    if (kd < 0.0) {
         return;
     }
-    let x = position[i];
-    let vel = hsm_velocity(v0.xyz, goal, x.xyz, state[owner[i]].wind.xyz, rest[i].w, step);
-    position[i] = vec4<f32>(x.xyz + vel * step.dt, x.w);
-    velocity[i] = vec4<f32>(vel, v0.w);
+    let x = displacement[i];
+    let vel = hsm_velocity(v0.xyz, goal, x.xyz, state[owner[i]].wind.xyz, kd, step);
+    displacement[i] = vec4<f32>(x.xyz + vel * step.dt, x.w);
+    velocity[i] = vec4<f32>(vel, kd);
 }

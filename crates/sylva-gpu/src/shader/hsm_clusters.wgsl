@@ -3,15 +3,14 @@
 // the slots, then a tree reduction), then one invocation extracts R, forms the goal
 // transform, α and the wind. CPU twin: sylva_core::cpu::hsm::hsm_clusters (same lanes, same
 // reduction tree). Bindings: 0 fields, 1 waves, 2 cluster info, 3 clusters, 4 slots,
-// 5 positions, 6 rest positions, 7 step, 8 cluster state.
+// 5 displacements from rest (w = mass), 6 step, 7 cluster state.
 
 @group(0) @binding(2) var<storage, read> info: array<HsmClusterInfo>;
 @group(0) @binding(3) var<storage, read> clusters: array<HsmCluster>;
 @group(0) @binding(4) var<storage, read> slots: array<HsmSlot>;
-@group(0) @binding(5) var<storage, read> position: array<vec4<f32>>;
-@group(0) @binding(6) var<storage, read> rest: array<vec4<f32>>;
-@group(0) @binding(7) var<storage, read> step: HsmStep;
-@group(0) @binding(8) var<storage, read_write> state: array<HsmClusterState>;
+@group(0) @binding(5) var<storage, read> displacement: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> step: HsmStep;
+@group(0) @binding(7) var<storage, read_write> state: array<HsmClusterState>;
 
 const LANES: u32 = 64u;
 
@@ -37,9 +36,9 @@ fn main(
     var a2 = vec3<f32>(0.0);
     for (var j = t; j < inf.slot_count; j += LANES) {
         let s = slots[inf.slot_offset + j];
-        let x = position[s.particle];
+        let x = displacement[s.particle];
         let m = x.w;
-        let u = x.xyz - rest[s.particle].xyz;
+        let u = x.xyz;
         let q = s.q;
         sm += u * m;
         let d = u + q;

@@ -1,12 +1,11 @@
-// Stage 3's gather, shared by hsm_goals and hsm_particles: a particle's goal (xyz) and
-// ᾱ = min(1, Σα) (w), the α-weighted mean of its clusters' goals as displacements from
-// rest, in cluster order. Binds group 0, bindings 0 member offsets, 1 members, 2 rest
-// positions, 3 cluster state. Twin: particle_goal in sylva_core::cpu::hsm.
+// Stage 3's gather, shared by hsm_goals and hsm_particles: a particle's goal as a
+// displacement from rest (xyz) and ᾱ = min(1, Σα) (w), the α-weighted mean of its clusters'
+// goals, in cluster order. Binds group 0, bindings 0 member offsets, 1 members, 2 cluster
+// state. Twin: particle_goal in sylva_core::cpu::hsm.
 
 @group(0) @binding(0) var<storage, read> member_offset: array<u32>;
 @group(0) @binding(1) var<storage, read> member: array<HsmMember>;
-@group(0) @binding(2) var<storage, read> rest: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read> state: array<HsmClusterState>;
+@group(0) @binding(2) var<storage, read> state: array<HsmClusterState>;
 
 fn hsm_particle_goal(i: u32) -> vec4<f32> {
     var sum = vec3<f32>(0.0);
@@ -17,9 +16,8 @@ fn hsm_particle_goal(i: u32) -> vec4<f32> {
         sum += hsm_goal_displacement(st, m.q) * st.cm.w;
         wsum += st.cm.w;
     }
-    let x0 = rest[i].xyz;
     if (wsum > 0.0) {
-        return vec4<f32>(x0 + sum / wsum, min(wsum, 1.0));
+        return vec4<f32>(sum / wsum, min(wsum, 1.0));
     }
-    return vec4<f32>(x0, 0.0);
+    return vec4<f32>(0.0);
 }
