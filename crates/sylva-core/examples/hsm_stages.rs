@@ -44,47 +44,36 @@ fn main() {
     }
     let step = h.step_params(1.0, 1.0 / 60.0);
     let (mut t1, mut t3, mut t4, mut tf) = (0.0, 0.0, 0.0, 0.0);
+    let timed = |acc: &mut f64, run: &mut dyn FnMut()| {
+        let t = Instant::now();
+        run();
+        *acc += t.elapsed().as_secs_f64();
+    };
     for _ in 0..n {
-        if only == "fused" {
-            let t = Instant::now();
-            hsm_particles(
-                &l.member_offset,
-                &l.member,
-                &st.clusters,
-                &l.owner,
-                step,
-                &mut st.displacement,
-                &mut st.velocity,
-            );
-            tf += t.elapsed().as_secs_f64();
-            continue;
+        if only != "fused" {
+            timed(&mut t1, &mut || {
+                hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut st.clusters)
+            });
         }
-        if only == "clusters" {
-            let t = Instant::now();
-            hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut st.clusters);
-            t1 += t.elapsed().as_secs_f64();
-            continue;
+        if only.is_empty() {
+            timed(&mut t3, &mut || hsm_goals(&l.member_offset, &l.member, &st.clusters, &mut st.goal));
+            timed(&mut t4, &mut || {
+                hsm_integrate(&l.owner, &st.clusters, &st.goal, step, &mut st.displacement, &mut st.velocity)
+            });
         }
-        let t = Instant::now();
-        hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut st.clusters);
-        t1 += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        hsm_goals(&l.member_offset, &l.member, &st.clusters, &mut st.goal);
-        t3 += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        hsm_integrate(&l.owner, &st.clusters, &st.goal, step, &mut st.displacement, &mut st.velocity);
-        t4 += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        hsm_particles(
-            &l.member_offset,
-            &l.member,
-            &st.clusters,
-            &l.owner,
-            step,
-            &mut st.displacement,
-            &mut st.velocity,
-        );
-        tf += t.elapsed().as_secs_f64();
+        if only != "clusters" {
+            timed(&mut tf, &mut || {
+                hsm_particles(
+                    &l.member_offset,
+                    &l.member,
+                    &st.clusters,
+                    &l.owner,
+                    step,
+                    &mut st.displacement,
+                    &mut st.velocity,
+                )
+            });
+        }
     }
     let np = l.particle_count() as f64;
     println!("clusters {} particles {} slots {} members {}", l.cluster_count(), np, l.slots.len(), l.member.len());
