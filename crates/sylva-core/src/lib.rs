@@ -12,6 +12,7 @@
 //!   (Weber & Penn 1995; Skjermo §2.1).
 //! * [`species`]: the presets shipped in `presets/` and loading of user files.
 //! * [`export`]: static OBJ output, written atomically.
+//! * [`simd`]: eight-lane vectors for the CPU fast paths, with AVX2 where the CPU has it.
 
 pub mod animate;
 pub mod cpu;
@@ -23,6 +24,7 @@ pub mod mesh;
 pub mod model;
 pub mod rng;
 pub mod scene;
+pub mod simd;
 pub mod species;
 pub mod wind;
 

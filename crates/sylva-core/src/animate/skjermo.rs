@@ -115,7 +115,7 @@ pub struct Skjermo {
     pub rest_orient: Vec<[f32; 4]>,
     /// Per-segment (stem, Bézier parameter of the segment's middle).
     pub segment_param: Vec<[f32; 4]>,
-    /// The per-stem constants in groups of eight for the fast CPU step.
+    /// The per-stem constants in groups of sixteen for the fast CPU step.
     pub lanes: Vec<StemLanes>,
     rest_lanes: Vec<StateLanes>,
 }
@@ -131,7 +131,7 @@ pub struct SkjermoState {
     pub time: f32,
     /// Current pose (with Béziers).
     pub pose: Pose,
-    /// The per-stem state in groups of eight (what the CPU step reads and writes; `stems`
+    /// The per-stem state in groups of sixteen (what the CPU step reads and writes; `stems`
     /// is copied from it after every step).
     pub lanes: Vec<StateLanes>,
     scratch: Vec<StateLanes>,
@@ -288,7 +288,7 @@ impl Skjermo {
     }
 
     /// Advances one step of `dt` seconds: all stems re-attach to their parents' previous
-    /// curves and bend (ping-pong, eight stems at a time), then the pose follows.
+    /// curves and bend (ping-pong, sixteen stems at a time), then the pose follows.
     pub fn step(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
         self.step_stems(fields, waves, state, dt);
         let lanes = &state.lanes;

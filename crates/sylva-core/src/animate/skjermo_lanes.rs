@@ -1,8 +1,8 @@
-//! Skjermo's step eight stems at a time: the fast CPU path.
+//! Skjermo's step sixteen stems at a time: the fast CPU path.
 //!
 //! `cpu::skjermo::skjermo_step` is the reference (the twin of `skjermo_step.wgsl`, one stem per
-//! invocation). This module computes the same step on groups of eight stems held as
-//! structure-of-arrays lanes (`wide::f32x8`), with the per-stem constants that do not change
+//! invocation). This module computes the same step on groups of sixteen stems held as
+//! structure-of-arrays lanes ([`crate::simd::F32x16`]), with the per-stem constants that do not change
 //! between steps folded in at setup:
 //!
 //! * the parent's curve enters only through its displacement from rest, because a Bézier is
@@ -13,22 +13,21 @@
 //!   still reproduces the rest curves bit for bit;
 //! * `p2_weight^exponent` is computed once per step, not once per stem.
 //!
-//! The wind is sampled on all eight lanes at once ([`crate::wind::lanes`]: a polynomial sine,
+//! The wind is sampled on all sixteen lanes at once ([`crate::wind::lanes`]: a polynomial sine,
 //! integer sharpness by repeated multiplication). Results agree with the
-//! reference to rounding (tested), and are identical whatever the thread count: every group is
-//! computed by the same instructions whichever thread runs it.
+//! reference to rounding (tested), and are identical whatever the thread count (every group is
+//! computed by the same instructions whichever thread runs it) and whatever the instruction
+//! set (`simd.rs`: AVX2 where the CPU has it, tested against the baseline).
 
 use super::skjermo::{RawSkjermoStem, bezier_d};
 use crate::model::NONE;
+use crate::simd::{Level, dispatch};
 pub use crate::wind::lanes::LANES;
-use crate::wind::lanes::{V3, wind_lanes};
+use crate::wind::lanes::{V, V3, wind_lanes};
 use crate::wind::raw::{RawField, RawWave};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::ops::{Add, Sub};
-use wide::{CmpGt, f32x8};
-
-type V = f32x8;
 
 /// The attachment frame `[T, N, B]` from a curve tangent and an orientation vector, as
 /// `animate::skjermo::frame`.
@@ -45,7 +44,7 @@ fn frame(tangent: V3, o: V3) -> [V3; 3] {
     [tan, n, tan.cross(n)]
 }
 
-/// Per-group constants of eight stems (padding lanes have no parent and zero sizes).
+/// Per-group constants of sixteen stems (padding lanes have no parent and zero sizes).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StemLanes {
     /// Parent stem of each lane (`NONE` for a trunk or a padding lane).
@@ -68,7 +67,7 @@ pub struct StemLanes {
     pub length: V,
 }
 
-/// Per-group state of eight stems: control-point displacements and orientation vectors.
+/// Per-group state of sixteen stems: control-point displacements and orientation vectors.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StateLanes {
     /// Displacements of P0..P3 from rest.
@@ -154,7 +153,7 @@ pub fn build(stems: &[RawSkjermoStem], rest_orient: &[[f32; 4]]) -> (Vec<StemLan
     (lanes, state)
 }
 
-/// Gathers the parents' previous state for the eight lanes of a group (a trunk or padding
+/// Gathers the parents' previous state for the sixteen lanes of a group (a trunk or padding
 /// lane sees no displacement and the orientation vector `X`, as the reference's trunk frame).
 #[inline(always)]
 fn gather(parent: &[u32; LANES], prev: &[StateLanes]) -> ([V3; 4], V3) {
@@ -200,7 +199,36 @@ pub fn step(
     step: LaneStep,
     next: &mut [StateLanes],
 ) {
-    next.par_iter_mut().zip(stems.par_iter()).with_min_len(16).for_each(|(out, st)| {
+    step_at(crate::simd::level(), fields, waves, stems, prev, step, next);
+}
+
+/// [`step`] at a given instruction-set level (to test that every level gives the same bits).
+#[doc(hidden)]
+pub fn step_at(
+    level: Level,
+    fields: &[RawField],
+    waves: &[RawWave],
+    stems: &[StemLanes],
+    prev: &[StateLanes],
+    step: LaneStep,
+    next: &mut [StateLanes],
+) {
+    next.par_chunks_mut(16).zip(stems.par_chunks(16)).for_each(|(out, st)| {
+        groups_at(level, fields, waves, st, prev, step, out);
+    });
+}
+
+dispatch! {
+/// The step for a run of groups.
+fn groups_at(
+    fields: &[RawField],
+    waves: &[RawWave],
+    stems: &[StemLanes],
+    prev: &[StateLanes],
+    step: LaneStep,
+    next: &mut [StateLanes],
+) {
+    for (out, st) in next.iter_mut().zip(stems) {
         let (dp, o_now) = gather(&st.parent, prev);
         let mut shift = V3::ZERO;
         for (w, d) in st.w.iter().zip(&dp) {
@@ -234,5 +262,6 @@ pub fn step(
         d[2] = d[2].add(c2);
         d[3] = d[3].add(c2.add(c3));
         *out = StateLanes { delta: d, orient: f_now[1] };
-    });
+    }
+}
 }

@@ -1,5 +1,5 @@
-//! The wind scene at eight points at once, for the CPU's lane paths (Skjermo's stems, the
-//! centres of HSM's clusters): `f32x8` lanes (`wide`), a polynomial sine, and every field
+//! The wind scene at sixteen points at once, for the CPU's lane paths (Skjermo's stems, the
+//! centres of HSM's clusters): [`crate::simd::F32x16`] lanes, a polynomial sine, and every field
 //! kind of `cpu::wind_sample::field_at` — constant, sum of sines and turbulence on the
 //! lanes, the localised events (gust front, vortex, blast) per lane through `field_at`.
 //! Agrees with `wind_at` to the sine's error (tested).
@@ -9,15 +9,13 @@ use crate::wind::raw::{RawField, RawWave, kind};
 use glam::Vec3;
 use std::f32::consts::TAU;
 use std::ops::{Add, Sub};
-use wide::{CmpGt, f32x8};
 
-/// Points per call.
-pub const LANES: usize = 8;
+pub use crate::simd::LANES;
 
 /// Eight `f32` lanes.
-pub type V = f32x8;
+pub type V = crate::simd::F32x16;
 
-/// Three lanes of eight: x, y and z of eight vectors.
+/// Three lanes of sixteen: x, y and z of sixteen vectors.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct V3 {
     /// x of each lane.
@@ -102,7 +100,7 @@ impl Sub for V3 {
     }
 }
 
-/// Sine on eight lanes: reduced to [−π, π] by whole turns, then an odd degree-11 polynomial
+/// Sine on sixteen lanes: reduced to [−π, π] by whole turns, then an odd degree-11 polynomial
 /// fitted to sine by least squares on Chebyshev nodes (absolute error < 2e-6 on [−π, π]; the reference's `sin`
 /// is correctly rounded, so the two paths differ by that much at most).
 #[inline(always)]
@@ -119,6 +117,7 @@ pub fn sin(x: V) -> V {
 }
 
 /// `x^k` for a small integer `k ≥ 0` by repeated squaring.
+#[inline(always)]
 pub fn powi(mut x: V, mut k: u32) -> V {
     let mut r = V::ONE;
     while k > 0 {
@@ -131,7 +130,7 @@ pub fn powi(mut x: V, mut k: u32) -> V {
     r
 }
 
-/// The wind scene at eight points (as `cpu::wind_sample::wind_at`).
+/// The wind scene at sixteen points (as `cpu::wind_sample::wind_at`).
 #[inline(always)]
 pub fn wind_lanes(fields: &[RawField], waves: &[RawWave], p: V3, t: f32) -> V3 {
     let mut v = V3::ZERO;
@@ -150,7 +149,7 @@ pub fn wind_lanes(fields: &[RawField], waves: &[RawWave], p: V3, t: f32) -> V3 {
                         let base = (s + V::ONE) * V::splat(0.5);
                         match int_sharp {
                             Some(k) => powi(base, k),
-                            None => base.pow_f32x8(V::splat(sharp)),
+                            None => base.powf(sharp),
                         }
                     };
                     v = v.add(V3::splat(Vec3::new(w.dir[0], w.dir[1], w.dir[2])).scale(h));
@@ -201,7 +200,7 @@ mod tests {
         }
     }
 
-    /// Every preset's scene at random points and times, eight at a time: within the
+    /// Every preset's scene at random points and times, sixteen at a time: within the
     /// polynomial sine's error (scaled by the summed wave amplitudes) of `wind_at`.
     #[test]
     fn lanes_match_wind_at_on_every_preset() {
