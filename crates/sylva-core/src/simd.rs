@@ -228,19 +228,17 @@ pub fn detected() -> Level {
 }
 
 /// Defines `$at(level, args)`, which runs the body compiled for `level`: pass [`level`] for
-/// the CPU's best, a lower one to test that every level gives the same bits. The body is
+/// the CPU's best, a lower one to test that every level gives the same bits (a level above
+/// [`detected`] runs at [`detected`], so no call can reach an instruction the CPU lacks). The body is
 /// compiled once per level; everything it calls in its loop must be `#[inline(always)]` so
 /// that it is compiled inside each copy.
 macro_rules! dispatch {
     ($(#[$m:meta])* $vis:vis fn $at:ident($($a:ident: $t:ty),* $(,)?) $body:block) => {
         $(#[$m])*
-        ///
-        /// # Panics
-        /// If the CPU lacks that level.
         $vis fn $at(level: $crate::simd::Level, $($a: $t),*) {
             #[inline(always)]
             fn kernel($($a: $t),*) $body
-            assert!(level <= $crate::simd::detected(), "the CPU has no {level:?}");
+            let level = level.min($crate::simd::detected());
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx2")]
@@ -248,7 +246,7 @@ macro_rules! dispatch {
                     kernel($($a),*)
                 }
                 match level {
-                    // SAFETY: the CPU has AVX2 (asserted above).
+                    // SAFETY: the CPU has AVX2 (`level` is capped by `detected` above).
                     #[allow(unsafe_code)]
                     $crate::simd::Level::Avx2 => return unsafe { avx2($($a),*) },
                     $crate::simd::Level::Baseline => {}

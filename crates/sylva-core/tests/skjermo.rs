@@ -165,12 +165,12 @@ fn the_lane_path_matches_the_reference_kernel() {
 }
 
 /// The lane step compiled for AVX2 (run where the CPU has it) and for the baseline x86-64
-/// gives the same bits: 200 steps of a gusty wind (lane turbulence, per-lane gust front,
-/// non-integer sharpness) and of integer-sharpness sines, every preset. On a CPU without
-/// AVX2 only the baseline runs, and the test says so.
+/// gives the same bits: 200 steps of `gusty` (lane sines with non-integer sharpness, lane
+/// turbulence, per-lane gust front) and of `blast` (per-lane blast field), every preset. On
+/// a CPU without AVX2 only the baseline runs, and the test says so.
 #[test]
 fn every_instruction_set_level_gives_the_same_bits() {
-    use sylva_core::animate::skjermo_lanes::{StateLanes, step_at};
+    use sylva_core::animate::skjermo_lanes::{StateLanes, step};
     use sylva_core::simd::{Level, detected};
     if detected() == Level::Baseline {
         println!("this CPU has no AVX2: only the baseline level runs");
@@ -190,7 +190,7 @@ fn every_instruction_set_level_gives_the_same_bits() {
                 let mut s = m.rest_state(&t).lanes;
                 let mut next = s.clone();
                 for k in 1..=200 {
-                    step_at(level, &f, &w, &m.lanes, &s, m.lane_step(k as f32 / 60.0), &mut next);
+                    step(level, &f, &w, &m.lanes, &s, m.lane_step(k as f32 / 60.0), &mut next);
                     std::mem::swap(&mut s, &mut next);
                 }
                 bits(&s)

@@ -269,7 +269,15 @@ impl Skjermo {
     /// This is the branch update Skjermo's figures count.
     pub fn step_stems(&self, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
         let t = state.time + dt;
-        skjermo_lanes::step(fields, waves, &self.lanes, &state.lanes, self.lane_step(t), &mut state.scratch);
+        skjermo_lanes::step(
+            crate::simd::level(),
+            fields,
+            waves,
+            &self.lanes,
+            &state.lanes,
+            self.lane_step(t),
+            &mut state.scratch,
+        );
         std::mem::swap(&mut state.lanes, &mut state.scratch);
         state.time = t;
         state.steps += 1;

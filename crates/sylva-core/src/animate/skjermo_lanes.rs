@@ -191,20 +191,9 @@ pub struct LaneStep {
 
 /// One step for every group: re-attach on the parents' previous curves, sample the wind at
 /// the tips, bend P2 and P3 (eqs. 15–17). Same step as `cpu::skjermo::skjermo_step`.
+/// `level`: the instruction set to run on, [`crate::simd::level`] for the CPU's best (every
+/// level gives the same bits).
 pub fn step(
-    fields: &[RawField],
-    waves: &[RawWave],
-    stems: &[StemLanes],
-    prev: &[StateLanes],
-    step: LaneStep,
-    next: &mut [StateLanes],
-) {
-    step_at(crate::simd::level(), fields, waves, stems, prev, step, next);
-}
-
-/// [`step`] at a given instruction-set level (to test that every level gives the same bits).
-#[doc(hidden)]
-pub fn step_at(
     level: Level,
     fields: &[RawField],
     waves: &[RawWave],

@@ -12,7 +12,7 @@ use std::ops::{Add, Sub};
 
 pub use crate::simd::LANES;
 
-/// Eight `f32` lanes.
+/// Sixteen `f32` lanes.
 pub type V = crate::simd::F32x16;
 
 /// Three lanes of sixteen: x, y and z of sixteen vectors.
