@@ -71,89 +71,114 @@ pub fn hsm_clusters(
     step: RawHsmStep,
     state: &mut [RawHsmClusterState],
 ) {
-    // Scratch lanes, one set per rayon job (not per cluster: only the lanes a cluster uses
-    // are written).
-    let scratch = || Box::new([[Vec3A::ZERO; 4]; LANES]);
-    state.par_iter_mut().enumerate().with_min_len(64).for_each_init(scratch, |lane, (c, st)| {
-        let inf = info[c];
-        let cl = &clusters[c];
-        let c0 = v3(cl.rest_cm);
-        // Lane sums [Σ m u, Apq columns] of the workgroup's invocations: lane j mod 64 adds
-        // slot j to zero, then slot j + 64, …; lanes past the slot count stay zero, so the
-        // reduction below needs only the next power of two.
-        let run = &slots[inf.slot_offset as usize..(inf.slot_offset + inf.slot_count) as usize];
-        let width = run.len().clamp(1, LANES).next_power_of_two();
-        let (first, rest) = run.split_at(run.len().min(LANES));
-        for (l, s) in lane.iter_mut().zip(first) {
-            // 0 + v as on the GPU (it maps −0 to +0).
-            *l = slot_terms(displacement[s.particle as usize], s).map(|v| Vec3A::ZERO + v);
+    // One parallel pass: each chunk of clusters gets its shape matching, then the wind at
+    // the new centres (fixed chunks, so the wind's lane groups do not depend on the threads).
+    const CHUNK: usize = 256;
+    let level = crate::simd::level();
+    state.par_chunks_mut(CHUNK).enumerate().for_each(|(k, chunk)| {
+        let base = k * CHUNK;
+        // A cluster's quarter lanes (see `cluster_sums`).
+        let mut quarter = [[Vec3A::ZERO; 4]; LANES / 4];
+        for (i, st) in chunk.iter_mut().enumerate() {
+            match_cluster(&info[base + i], &clusters[base + i], slots, displacement, &step, &mut quarter, st);
         }
-        lane[first.len()..width].fill([Vec3A::ZERO; 4]);
-        for (j, s) in rest.iter().enumerate() {
-            let l = &mut lane[j % LANES];
-            for (x, v) in l.iter_mut().zip(slot_terms(displacement[s.particle as usize], s)) {
-                *x += v;
-            }
+        if !fields.is_empty() {
+            wind_chunk_at(level, fields, waves, &info[base..base + chunk.len()], step.time, chunk);
         }
-        let mut stride = width / 2;
-        while stride > 0 {
-            // Invocation t < stride adds lane t + stride to lane t (one barrier per level).
-            let (low, high) = lane.split_at_mut(stride);
-            for (a, b) in low.iter_mut().zip(&high[..stride]) {
-                for (x, y) in a.iter_mut().zip(b) {
-                    *x += *y;
-                }
-            }
-            stride /= 2;
-        }
-        let [sm, a0, a1, a2] = lane[0].map(Vec3::from);
-        let shift = sm / cl.mass;
-        let cm = c0 + shift;
-        // Σ m q = 0, so Σ m (x − c⁰) qᵀ is Apq = Σ m (x − c) qᵀ.
-        let apq = Mat3::from_cols(a0, a1, a2);
-        let q = extract_rotation(apq, Quat::from_array(st.rotation), step.polar_iterations);
-        let r = Mat3::from_quat(q);
-        let mut t = r;
-        if step.beta > 0.0 {
-            let aqq_inv = Mat3::from_cols(v3(cl.aqq_inv[0]), v3(cl.aqq_inv[1]), v3(cl.aqq_inv[2]));
-            let a = apq * aqq_inv;
-            let det = a.determinant();
-            if det > 1e-6 {
-                t = a * (step.beta / det.powf(1.0 / 3.0)) + r * (1.0 - step.beta);
-            }
-        }
-        let alpha = (cl.rest_cm[3] * step.dt * step.dt).min(1.0);
-        st.cm = [cm.x, cm.y, cm.z, alpha];
-        st.rotation = q.to_array();
-        st.transform =
-            [t.x_axis.extend(shift.x).into(), t.y_axis.extend(shift.y).into(), t.z_axis.extend(shift.z).into()];
-        st.wind = [0.0; 4];
     });
-    cluster_wind(fields, waves, info, step.time, state);
 }
 
-/// The wind at the centres of the segment clusters (a leaf feels the wind sampled for its
-/// segment: stage 4 reads it there, and a leaf cluster's stays zero). The WGSL samples it in
-/// the cluster's own invocation; here it is sampled sixteen centres at a time
-/// ([`crate::wind::lanes`]), in fixed groups, so the result does not depend on the threads.
-fn cluster_wind(
-    fields: &[RawField],
-    waves: &[RawWave],
-    info: &[RawHsmClusterInfo],
-    time: f32,
-    state: &mut [RawHsmClusterState],
+/// Stage 1 for one cluster (one workgroup of `hsm_clusters.wgsl`), the wind aside.
+#[inline(always)]
+fn match_cluster(
+    inf: &RawHsmClusterInfo,
+    cl: &RawHsmCluster,
+    slots: &[RawHsmSlot],
+    displacement: &[[f32; 4]],
+    step: &RawHsmStep,
+    quarter: &mut [[Vec3A; 4]; LANES / 4],
+    st: &mut RawHsmClusterState,
 ) {
-    if fields.is_empty() {
-        return;
+    let c0 = v3(cl.rest_cm);
+    let run = &slots[inf.slot_offset as usize..(inf.slot_offset + inf.slot_count) as usize];
+    let [sm, a0, a1, a2] = cluster_sums(run, displacement, quarter).map(Vec3::from);
+    let shift = sm / cl.mass;
+    let cm = c0 + shift;
+    // Σ m q = 0, so Σ m (x − c⁰) qᵀ is Apq = Σ m (x − c) qᵀ.
+    let apq = Mat3::from_cols(a0, a1, a2);
+    let q = extract_rotation(apq, Quat::from_array(st.rotation), step.polar_iterations);
+    let r = Mat3::from_quat(q);
+    let mut t = r;
+    if step.beta > 0.0 {
+        let aqq_inv = Mat3::from_cols(v3(cl.aqq_inv[0]), v3(cl.aqq_inv[1]), v3(cl.aqq_inv[2]));
+        let a = apq * aqq_inv;
+        let det = a.determinant();
+        if det > 1e-6 {
+            t = a * (step.beta / det.powf(1.0 / 3.0)) + r * (1.0 - step.beta);
+        }
     }
-    const CHUNK: usize = 256;
-    state.par_chunks_mut(CHUNK).enumerate().for_each(|(k, chunk)| {
-        wind_chunk_at(crate::simd::level(), fields, waves, &info[k * CHUNK..k * CHUNK + chunk.len()], time, chunk);
-    });
+    let alpha = (cl.rest_cm[3] * step.dt * step.dt).min(1.0);
+    st.cm = [cm.x, cm.y, cm.z, alpha];
+    st.rotation = q.to_array();
+    st.transform = [t.x_axis.extend(shift.x).into(), t.y_axis.extend(shift.y).into(), t.z_axis.extend(shift.z).into()];
+    st.wind = [0.0; 4];
+}
+
+/// Lane `t`'s sums as invocation `t` of `hsm_clusters.wgsl` adds them: zero, plus slot `t`,
+/// slot `t + 64`, …; zero for a lane past the slot count.
+#[inline(always)]
+fn lane_sums(run: &[RawHsmSlot], displacement: &[[f32; 4]], t: usize) -> [Vec3A; 4] {
+    let mut acc = [Vec3A::ZERO; 4];
+    for s in run.iter().skip(t).step_by(LANES) {
+        for (a, v) in acc.iter_mut().zip(slot_terms(displacement[s.particle as usize], s)) {
+            *a += v;
+        }
+    }
+    acc
+}
+
+#[inline(always)]
+fn add4(a: [Vec3A; 4], b: [Vec3A; 4]) -> [Vec3A; 4] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
+}
+
+/// Stage 1's sums `[Σ m u, Apq columns]` of one cluster's slots `run`, added in the order of
+/// the workgroup in `hsm_clusters.wgsl`: its lanes (see [`lane_sums`]; lanes past the slot
+/// count are zero, so only the next power of two of them take part) are halved, lane `t`
+/// taking lane `t + stride`, down to lane 0. The two widest halvings are done in registers
+/// as each quarter's lane is formed, `(v_t + v_{t+W/2}) + (v_{t+W/4} + v_{t+3W/4})`, and only
+/// the quarter's lanes go through memory: the same additions in the same order, so the same
+/// bits, without writing every slot's terms out and reading them back.
+#[inline(always)]
+fn cluster_sums(run: &[RawHsmSlot], displacement: &[[f32; 4]], quarter: &mut [[Vec3A; 4]; LANES / 4]) -> [Vec3A; 4] {
+    let width = run.len().clamp(1, LANES).next_power_of_two();
+    let lane = |t: usize| lane_sums(run, displacement, t);
+    match width {
+        1 => lane(0),
+        2 => add4(lane(0), lane(1)),
+        _ => {
+            let q = width / 4;
+            for (t, l) in quarter[..q].iter_mut().enumerate() {
+                *l = add4(add4(lane(t), lane(t + 2 * q)), add4(lane(t + q), lane(t + 3 * q)));
+            }
+            let mut stride = q / 2;
+            while stride > 0 {
+                // Invocation t < stride adds lane t + stride to lane t (one barrier per level).
+                for t in 0..stride {
+                    quarter[t] = add4(quarter[t], quarter[t + stride]);
+                }
+                stride /= 2;
+            }
+            quarter[0]
+        }
+    }
 }
 
 dispatch! {
-/// [`cluster_wind`] for one chunk of clusters.
+/// The wind at the centres of one chunk's segment clusters (a leaf feels the wind sampled
+/// for its segment: stage 4 reads it there, and a leaf cluster's stays zero). The WGSL
+/// samples it in the cluster's own invocation; here sixteen centres at a time
+/// ([`crate::wind::lanes`]).
 fn wind_chunk_at(
     fields: &[RawField],
     waves: &[RawWave],
@@ -315,6 +340,54 @@ mod tests {
     use crate::simd::{Level, detected};
     use crate::wind::WindScene;
     use rand::{Rng, SeedableRng};
+
+    /// The workgroup of `hsm_clusters.wgsl`, step by step: 64 lanes, lane `j mod 64` adding
+    /// slot `j`, then the halving over all 64 lanes (zeros included).
+    fn workgroup_sums(run: &[RawHsmSlot], displacement: &[[f32; 4]]) -> [Vec3A; 4] {
+        let mut lane = [[Vec3A::ZERO; 4]; LANES];
+        for (j, s) in run.iter().enumerate() {
+            lane[j % LANES] = add4(lane[j % LANES], slot_terms(displacement[s.particle as usize], s));
+        }
+        let mut stride = LANES / 2;
+        while stride > 0 {
+            for t in 0..stride {
+                lane[t] = add4(lane[t], lane[t + stride]);
+            }
+            stride /= 2;
+        }
+        lane[0]
+    }
+
+    /// `cluster_sums` (two halvings in registers, zero lanes skipped) adds exactly as the
+    /// full 64-lane workgroup does: the same bits for 0 to 200 slots, signed zeros and
+    /// magnitudes from 1e-6 to 1e3 included.
+    #[test]
+    fn cluster_sums_add_as_the_workgroup_does() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        let value = |rng: &mut rand_chacha::ChaCha8Rng| match rng.random_range(0..8) {
+            0 => 0.0,
+            1 => -0.0,
+            _ => rng.random_range(-1.0f32..1.0) * 10f32.powi(rng.random_range(-6..4)),
+        };
+        let mut quarter = [[Vec3A::ZERO; 4]; LANES / 4];
+        for count in (0..=200).chain([256, 257]) {
+            let displacement: Vec<[f32; 4]> = (0..count + 3)
+                .map(|_| [value(&mut rng), value(&mut rng), value(&mut rng), rng.random_range(0.01..2.0)])
+                .collect();
+            let run: Vec<RawHsmSlot> = (0..count)
+                .map(|_| RawHsmSlot {
+                    q: [value(&mut rng), value(&mut rng), value(&mut rng)],
+                    particle: rng.random_range(0..displacement.len() as u32),
+                })
+                .collect();
+            let bits = |s: [Vec3A; 4]| s.map(|v| v.to_array().map(f32::to_bits));
+            assert_eq!(
+                bits(cluster_sums(&run, &displacement, &mut quarter)),
+                bits(workgroup_sums(&run, &displacement)),
+                "{count} slots"
+            );
+        }
+    }
 
     /// The cluster wind compiled for AVX2 (where the CPU has it) and for the baseline gives
     /// the same bits, at random centres and times, on every wind preset; leaf clusters keep
