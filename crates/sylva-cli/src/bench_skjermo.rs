@@ -5,7 +5,7 @@
 //! and 262,143 stems). An update is the step the paper counts: every stem re-attaches to
 //! its parent's curve from the previous step, samples the wind and bends P2 and P3 (eqs.
 //! 15–17), the two state buffers ping-ponging; no pose, no mesh. The wind is the paper's
-//! setting, four sines (eqs. 11–14). CPU rows time the fast path (eight stems per lane
+//! setting, four sines (eqs. 11–14). CPU rows time the fast path (sixteen stems per lane
 //! group, rayon) and the reference kernel (one stem at a time, the WGSL's twin); GPU rows
 //! `skjermo.wgsl`, one dispatch per update. `--quick` times 4,095 and 16,383 branches
 //! instead (no paper figure).
