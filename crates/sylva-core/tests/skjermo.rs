@@ -31,6 +31,30 @@ fn still_air_keeps_the_exact_rest_pose_and_curves() {
     }
 }
 
+/// The rest orientations are a fixed point of one level of `skjermo_rest_orient` (what the
+/// GPU runs to round them as it rounds its steps): applied depth + 1 times from zeros it
+/// gives `Skjermo::rest_orient` bit for bit, and fewer times does not (so the depth is
+/// needed and counted right).
+#[test]
+fn the_rest_orientation_kernel_rebuilds_the_rest_orientations() {
+    use sylva_core::cpu::skjermo::{skjermo_rest_orient, stem_depth};
+    for p in PRESETS {
+        let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
+        let m = Skjermo::new(&t, SkjermoParams::default());
+        let depth = stem_depth(&m.stems);
+        let mut a = vec![[0.0f32; 4]; m.stems.len()];
+        let mut b = a.clone();
+        for level in 0..=depth {
+            if level == depth && depth > 0 {
+                assert_ne!(a, m.rest_orient, "{}: converged before the deepest level", p.name);
+            }
+            skjermo_rest_orient(&m.stems, &a, &mut b);
+            std::mem::swap(&mut a, &mut b);
+        }
+        assert_eq!(a, m.rest_orient, "{}", p.name);
+    }
+}
+
 #[test]
 fn constant_wind_bends_downwind_more_as_it_rises() {
     for name in ["quaking_aspen", "monopodial"] {

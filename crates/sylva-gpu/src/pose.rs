@@ -494,15 +494,25 @@ impl GpuSkjermo {
         use sylva_core::animate::skjermo::RawSkjermoState;
         let (fields, waves) = wind.pack();
         let (wind_fields, wind_waves) = crate::wind_sample::upload_wind(ctx, &fields, &waves)?;
+        // The rest orientations as this device rounds them (a GPU that fuses multiply-adds
+        // rounds the attachment frames differently from the CPU): with the CPU's, a step in
+        // still air would move the stems by rounding errors instead of keeping the rest.
+        let orient = Self::rest_orientations(ctx, method)?;
+        let mut stems = method.stems.clone();
+        for st in &mut stems {
+            if st.parent != sylva_core::model::NONE {
+                st.parent_orient = orient[st.parent as usize];
+            }
+        }
         let rest: Vec<RawSkjermoState> =
-            method.rest_orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect();
+            orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect();
         Ok(Self {
             step_kernel: Kernel::cached(ctx, "skjermo_step", &[QUAT, TREE, NOISE, WIND, SKJERMO, SKJERMO_STEP]),
             rotations: Kernel::cached(ctx, "skjermo_rotations", &[QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS]),
             pose: GpuPose::new(ctx, tree)?,
             fields: wind_fields,
             waves: wind_waves,
-            stems: upload(ctx, "skjermo stems", &method.stems)?,
+            stems: upload(ctx, "skjermo stems", &stems)?,
             params: upload(ctx, "segment params", &method.segment_param)?,
             step: upload(ctx, "skjermo step", &[method.step_params(0.0)])?,
             state: [upload(ctx, "skjermo state a", &rest)?, upload(ctx, "skjermo state b", &rest)?],
@@ -511,6 +521,29 @@ impl GpuSkjermo {
             method_step: method.step_params(0.0),
             time: 0.0,
         })
+    }
+
+    /// The rest orientation vectors computed on the device: `skjermo_rest_orient` once per
+    /// stem depth, ping-pong (waits for the GPU).
+    fn rest_orientations(
+        ctx: &GpuContext,
+        method: &sylva_core::animate::skjermo::Skjermo,
+    ) -> Result<Vec<[f32; 4]>, GpuError> {
+        use crate::shader::{SKJERMO, SKJERMO_REST_ORIENT};
+        let kernel = Kernel::cached(ctx, "skjermo_rest_orient", &[QUAT, TREE, SKJERMO, SKJERMO_REST_ORIENT]);
+        let stems = upload(ctx, "skjermo stems", &method.stems)?;
+        let orient = [
+            upload(ctx, "skjermo rest orientations a", &method.rest_orient)?,
+            output::<[f32; 4]>(ctx, "skjermo rest orientations b", method.stems.len())?,
+        ];
+        let levels = sylva_core::cpu::skjermo::stem_depth(&method.stems) + 1;
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        for level in 0..levels {
+            let (from, to) = (&orient[level % 2], &orient[1 - level % 2]);
+            kernel.record(ctx, &mut e, &[&stems, from, to], method.stems.len() as u32);
+        }
+        ctx.queue.submit([e.finish()]);
+        read_back(ctx, &orient[levels % 2], method.stems.len())
     }
 
     /// Advances by one step of `dt` seconds (submitted, not waited for).

@@ -11,9 +11,16 @@ use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
 use sylva_gpu::pose::{FkStrategy, GpuPose, GpuZioma};
 
+/// The angle between two nearby unit quaternions: |q₁ − q₂| ≈ half of it (acos near 1
+/// cannot resolve 1e-4 rad in f32).
+fn angle(a: Quat, b: Quat) -> f32 {
+    2.0 * (a - b).length().min((a + b).length())
+}
+
 /// Joint positions agree within 1e-4 × tree height (the bound); orientations within
-/// 1e-4 rad. Both sides walk the same ancestor chains with the same f32 operations.
-fn compare(t: &Tree, cpu: &Pose, gpu: &Pose, what: &str) -> f32 {
+/// 1e-4 rad plus `allowance[i]` where given. Both sides walk the same ancestor chains with
+/// the same f32 operations.
+fn compare_within(t: &Tree, cpu: &Pose, gpu: &Pose, allowance: Option<&[f32]>, what: &str) -> f32 {
     let height = t.height();
     let tol = 1e-4 * height;
     let mut worst = 0.0f32;
@@ -21,13 +28,31 @@ fn compare(t: &Tree, cpu: &Pose, gpu: &Pose, what: &str) -> f32 {
         let d = (cpu.start[i] - gpu.start[i]).length();
         worst = worst.max(d / height);
         assert!(d <= tol, "{what}: segment {i} joint {} vs {} (tol {tol})", cpu.start[i], gpu.start[i]);
-        // |q₁ − q₂| ≈ half the angle between them for nearby unit quaternions (acos near 1
-        // cannot resolve 1e-4 rad in f32).
-        let (a, b) = (cpu.orientation[i], gpu.orientation[i]);
-        let half = (a - b).length().min((a + b).length());
-        assert!(2.0 * half <= 1e-4, "{what}: segment {i} turned {} rad apart", 2.0 * half);
+        let turn = angle(cpu.orientation[i], gpu.orientation[i]);
+        let bound = 1e-4 + allowance.map_or(0.0, |a| a[i]);
+        assert!(turn <= bound, "{what}: segment {i} turned {turn} rad apart (bound {bound})");
     }
     worst
+}
+
+fn compare(t: &Tree, cpu: &Pose, gpu: &Pose, what: &str) -> f32 {
+    compare_within(t, cpu, gpu, None, what)
+}
+
+/// How far each segment of Zioma's pose turns when time moves by two f32 ulps either way
+/// (rad). Zioma's angles are functions of phases `f t + φ` (branch noise at up to 2.7 × a
+/// twig's frequency, the wind's `ω t`), and at t ≈ 100 s one ulp of such a phase is ~1e-5 of
+/// a cycle or more; a GPU that fuses `f * t + φ` into one rounding, as NVIDIA's Vulkan driver
+/// does, rounds the phase differently from the CPU by about that much. Measured on an NVIDIA
+/// H100: twigs 1.8e-4 rad apart at t = 118 s, over the plain 1e-4 rad bound; lavapipe,
+/// which does not fuse, stays under 1e-5.
+fn time_rounding_allowance(z: &Zioma, t: &Tree, wind: &WindScene, time: f32) -> Vec<f32> {
+    let at = z.pose(t, wind, time);
+    let dt = 2.0 * time.abs() * 2f32.powi(-23);
+    let (early, late) = (z.pose(t, wind, time - dt), z.pose(t, wind, time + dt));
+    (0..t.segments.len())
+        .map(|i| angle(at.orientation[i], early.orientation[i]).max(angle(at.orientation[i], late.orientation[i])))
+        .collect()
 }
 
 #[test]
@@ -97,7 +122,8 @@ fn zioma_matches_on_every_preset_at_random_times() {
             let time = rng.random_range(0.0..120.0);
             let a = z.pose(&t, &wind, time);
             let b = gpu.pose(ctx, &t, &z, time).unwrap();
-            worst = worst.max(compare(&t, &a, &b, p.name));
+            let allowance = time_rounding_allowance(&z, &t, &wind, time);
+            worst = worst.max(compare_within(&t, &a, &b, Some(&allowance), p.name));
         }
         println!("zioma {:<16} worst joint difference {worst:.2e} × height", p.name);
     }

@@ -25,13 +25,11 @@ fn samples(seed: u64) -> Vec<[f32; 4]> {
 }
 
 /// One scene per field kind, with randomised parameters, and each field's tolerance: the
-/// largest allowed |v_gpu − v_cpu| as a fraction of the field's peak speed.
+/// largest allowed |v_gpu − v_cpu| as a fraction of the field's peak speed, beyond the
+/// phase allowance of [`phase_allowance`].
 ///
 /// 1e-5 for every field: a handful of f32 operations whose rounding may differ (exp and sin
-/// are not correctly rounded on either side). Measured on lavapipe: ≤ 5e-7. The phases of
-/// the sums of sines and of turbulence reach ~1,500 rad, whose last bit is ~1e-4 rad: a GPU
-/// that contracts `a * b + c` into a fused multiply-add where the CPU does not could exceed
-/// this bound there; lavapipe does not.
+/// are not correctly rounded on either side). Measured on lavapipe: ≤ 5e-7.
 fn scenes(rng: &mut rand::rngs::StdRng) -> Vec<(&'static str, WindScene, f32, f32)> {
     let mut r = |a: f32, b: f32| rng.random_range(a..b);
     let constant = Constant { direction: [r(-1.0, 1.0), r(-0.2, 0.2), r(-1.0, 1.0)], speed: r(1.0, 20.0) };
@@ -102,6 +100,41 @@ fn scenes(rng: &mut rand::rngs::StdRng) -> Vec<(&'static str, WindScene, f32, f3
     ]
 }
 
+/// How far rounding alone can move a wave field at one sample (m/s). A wave's phase
+/// `θ = k·x + ωt` (sums of sines) or `2π cycles − k·x` (turbulence) reaches ~1,500 rad here,
+/// where one f32 ulp is ~1e-4 rad; a GPU that fuses `a * b + c` into one rounding, as NVIDIA's
+/// Vulkan driver does, rounds θ differently from the CPU, and its `sin` of a large argument
+/// reduces it differently too. So each wave may differ by its amplitude × the slope of its
+/// profile (1 for eq. 13 and turbulence, sharpness/2 for eq. 14) × two ulps of |θ| (bounded
+/// by |θ| 2⁻²²). Measured on an NVIDIA H100: 1.7e-5 × peak for eq. 13, which exceeded the
+/// plain 1e-5 bound. Fields without waves get none.
+fn phase_allowance(
+    fields: &[sylva_core::wind::raw::RawField],
+    waves: &[sylva_core::wind::raw::RawWave],
+    x: [f32; 4],
+) -> f32 {
+    use sylva_core::wind::raw::kind;
+    let p = Vec3::new(x[0], x[1], x[2]);
+    let mut allow = 0.0f32;
+    for f in fields {
+        let slope = match f.kind {
+            kind::SUM_OF_SINES if f.a[1] >= 0.5 => (0.5 * f.a[0]).max(1.0),
+            kind::SUM_OF_SINES | kind::TURBULENCE => 1.0,
+            _ => continue,
+        };
+        for w in &waves[f.wave_offset as usize..(f.wave_offset + f.wave_count) as usize] {
+            let k = Vec3::from_slice(&w.k[..3]);
+            let theta = if f.kind == kind::TURBULENCE {
+                std::f32::consts::TAU + k.dot(p).abs()
+            } else {
+                (k.dot(p) + w.k[3] * x[3]).abs()
+            };
+            allow += Vec3::from_slice(&w.dir[..3]).length() * slope * theta * 2f32.powi(-22);
+        }
+    }
+    allow
+}
+
 #[test]
 fn every_field_matches_on_a_million_random_samples() {
     let Some(ctx) = common::gpu() else { return };
@@ -113,14 +146,21 @@ fn every_field_matches_on_a_million_random_samples() {
         let mut cpu = vec![[0.0f32; 4]; s.len()];
         sylva_core::cpu::wind_sample(&fields, &waves, &s, &mut cpu);
         let mut worst = 0.0f32;
+        let mut worst_share = 0.0f32;
         let mut nonzero = 0usize;
         for i in 0..s.len() {
-            let d = (Vec3::from_slice(&gpu[i][..3]) - Vec3::from_slice(&cpu[i][..3])).length() / peak;
-            worst = worst.max(d);
+            let d = (Vec3::from_slice(&gpu[i][..3]) - Vec3::from_slice(&cpu[i][..3])).length();
+            let bound = tol * peak + phase_allowance(&fields, &waves, s[i]);
+            worst = worst.max(d / peak);
+            worst_share = worst_share.max(d / bound);
+            assert!(d <= bound, "{name}: sample {i} {:?}: |Δv| = {d:e} > {bound:e}", s[i]);
             nonzero += (Vec3::from_slice(&cpu[i][..3]).length() > 1e-3 * peak) as usize;
         }
-        println!("{name:<22} worst |Δv| / peak = {worst:.2e} (tolerance {tol:.0e}), {nonzero} non-zero samples");
-        assert!(worst <= tol, "{name}: {worst:e} > {tol:e}");
+        println!(
+            "{name:<22} worst |Δv| / peak = {worst:.2e} (tolerance {tol:.0e} + phase allowance; worst {:.0}% of the \
+             bound), {nonzero} non-zero samples",
+            100.0 * worst_share
+        );
         assert!(nonzero > 1000, "{name}: the random samples barely touch the field ({nonzero})");
     }
 }
@@ -137,9 +177,11 @@ fn a_composed_scene_matches_too() {
     }
     let s = samples(2);
     let gpu = sylva_gpu::wind_sample::WindSampler::new(ctx, &scene).unwrap().sample(ctx, &s[..200_000]).unwrap();
+    let (fields, waves) = scene.pack();
     for (i, x) in s[..200_000].iter().enumerate().step_by(7) {
         let cpu = scene.sample(Vec3::new(x[0], x[1], x[2]), x[3]);
-        assert!((Vec3::from_slice(&gpu[i][..3]) - cpu).length() <= 1e-5 * peak, "sample {i}");
+        let bound = 1e-5 * peak + phase_allowance(&fields, &waves, *x);
+        assert!((Vec3::from_slice(&gpu[i][..3]) - cpu).length() <= bound, "sample {i}");
     }
 }
 

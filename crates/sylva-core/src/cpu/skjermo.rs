@@ -1,5 +1,5 @@
-//! CPU twins of `shader/skjermo_step.wgsl` and `shader/skjermo_rotations.wgsl`
-//! (see [`crate::animate::skjermo`]).
+//! CPU twins of `shader/skjermo_step.wgsl`, `shader/skjermo_rotations.wgsl` and
+//! `shader/skjermo_rest_orient.wgsl` (see [`crate::animate::skjermo`]).
 
 use crate::animate::skjermo::{RawSkjermoState, RawSkjermoStem, RawSkjermoStep, bezier, bezier_d, frame};
 use crate::cpu::wind_sample::wind_at;
@@ -68,6 +68,37 @@ pub fn skjermo_step(
     });
 }
 
+/// One level of the rest orientation vectors: each stem's is the normal of its rest
+/// attachment frame on its parent's rest curve, turned by the parent's orientation in
+/// `orient_in` (a trunk's from +X at its base). Applied once per stem depth, starting from
+/// anything, it gives [`crate::animate::skjermo::Skjermo::rest_orient`]; the GPU runs its
+/// twin so that its rest orientations are rounded as its own steps round them, and a step in
+/// still air keeps the rest exactly. Bindings: 0 stems, 1 orientations in, 2 out.
+pub fn skjermo_rest_orient(stems: &[RawSkjermoStem], orient_in: &[[f32; 4]], orient_out: &mut [[f32; 4]]) {
+    orient_out.par_iter_mut().enumerate().for_each(|(k, out)| {
+        let st = &stems[k];
+        let f = if st.parent == NONE {
+            frame(&st.rest.map(v3), Vec3::X, 0.0)
+        } else {
+            let p = st.parent as usize;
+            frame(&stems[p].rest.map(v3), v3(orient_in[p]), st.attach)
+        };
+        *out = f[1].extend(0.0).to_array();
+    });
+}
+
+/// Depth of the deepest stem (0 for a trunk alone): how many times
+/// [`skjermo_rest_orient`] must run, less one. Stems are in topological order.
+pub fn stem_depth(stems: &[RawSkjermoStem]) -> usize {
+    let mut depth = vec![0usize; stems.len()];
+    for (k, st) in stems.iter().enumerate() {
+        if st.parent != NONE {
+            depth[k] = depth[st.parent as usize] + 1;
+        }
+    }
+    depth.into_iter().max().unwrap_or(0)
+}
+
 /// Absolute rotation of a segment: its stem's rest tangent at the segment's middle turned
 /// onto the current tangent.
 fn segment_rotation(param: [f32; 4], stems: &[RawSkjermoStem], state: &[RawSkjermoState]) -> Quat {
@@ -80,11 +111,13 @@ fn segment_rotation(param: [f32; 4], stems: &[RawSkjermoStem], state: &[RawSkjer
 }
 
 /// The rotation taking unit `a` onto unit `b`, `normalize(a × b, 1 + a·b)`: exactly the
-/// identity when `a == b`, and faithful for tiny angles (no snapping to the identity).
-/// Falls back to the identity for a zero vector or opposite directions.
+/// identity when `a == b` (tested, not left to `a × a`, which a fused multiply-add leaves at
+/// the rounding error of a product instead of zero), and faithful for tiny angles (no
+/// snapping to the identity). Falls back to the identity for a zero vector or opposite
+/// directions.
 pub fn shortest_arc(a: Vec3, b: Vec3) -> Quat {
     let w = 1.0 + a.dot(b);
-    if a == Vec3::ZERO || b == Vec3::ZERO || w < 1e-6 {
+    if a == b || a == Vec3::ZERO || b == Vec3::ZERO || w < 1e-6 {
         return Quat::IDENTITY;
     }
     let c = a.cross(b);

@@ -72,16 +72,14 @@ fn quat_to_mat3(q: vec4<f32>) -> mat3x3<f32> {
     );
 }
 
-// The rotation of `a` (Müller, Bender, Chentanez & Macklin 2016), warm-started from `q0`;
-// never NaN (see the CPU twin).
+// The rotation of `a` (Müller, Bender, Chentanez & Macklin 2016) with a Newton step,
+// warm-started from `q0`; never NaN (see the CPU twin `extract_rotation`).
 fn extract_rotation(a: mat3x3<f32>, q0: vec4<f32>, iterations: u32) -> vec4<f32> {
     var q = q0;
     let eps = 1e-6 * (length(a[0]) + length(a[1]) + length(a[2])) + 1e-30;
     for (var k = 0u; k < iterations; k++) {
         let r = quat_to_mat3(q);
-        let num = cross(r[0], a[0]) + cross(r[1], a[1]) + cross(r[2], a[2]);
-        let den = abs(dot(r[0], a[0]) + dot(r[1], a[1]) + dot(r[2], a[2])) + eps;
-        let omega = num / den;
+        let omega = rotation_step(r, a, eps);
         let w = length(omega);
         if (w < 2e-6) {
             break;
@@ -90,6 +88,42 @@ fn extract_rotation(a: mat3x3<f32>, q0: vec4<f32>, iterations: u32) -> vec4<f32>
     }
     return q;
 }
+
+// One step: Newton's H⁻¹ g with H = tr(B) I − sym(B), B = A Rᵀ, near the optimum where H is
+// safely positive definite, else Müller's g / (|tr B| + ε). Twin: rotation_step in sylva_core::cpu::hsm.
+fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, eps: f32) -> vec3<f32> {
+    let g = cross(r[0], a[0]) + cross(r[1], a[1]) + cross(r[2], a[2]);
+    let tr = dot(r[0], a[0]) + dot(r[1], a[1]) + dot(r[2], a[2]);
+    let b0 = a[0] * r[0].x + a[1] * r[1].x + a[2] * r[2].x;
+    let b1 = a[0] * r[0].y + a[1] * r[1].y + a[2] * r[2].y;
+    let b2 = a[0] * r[0].z + a[1] * r[1].z + a[2] * r[2].z;
+    let h00 = tr - b0.x;
+    let h11 = tr - b1.y;
+    let h22 = tr - b2.z;
+    let h01 = -0.5 * (b1.x + b0.y);
+    let h02 = -0.5 * (b2.x + b0.z);
+    let h12 = -0.5 * (b2.y + b1.z);
+    let c00 = h11 * h22 - h12 * h12;
+    let c01 = h02 * h12 - h01 * h22;
+    let c02 = h01 * h12 - h02 * h11;
+    let c11 = h00 * h22 - h02 * h02;
+    let c12 = h01 * h02 - h00 * h12;
+    let c22 = h00 * h11 - h01 * h01;
+    let det = h00 * c00 + h01 * c01 + h02 * c02;
+    let muller = g / (abs(tr) + eps);
+    if (dot(muller, muller) < NEWTON_NEAR * NEWTON_NEAR && tr > 0.0 && h00 > 0.0 && c22 > 0.0
+        && det > 1e-4 * (tr * tr * tr)) {
+        return vec3<f32>(
+            c00 * g.x + c01 * g.y + c02 * g.z,
+            c01 * g.x + c11 * g.y + c12 * g.z,
+            c02 * g.x + c12 * g.y + c22 * g.z,
+        ) / det;
+    }
+    return muller;
+}
+
+// Müller's step below which rotation_step takes Newton's, rad (NEWTON_NEAR on the CPU).
+const NEWTON_NEAR: f32 = 0.05;
 
 // A cluster's goal for rest offset q, as a displacement from rest: (T q − q) + (c − c⁰).
 // Twin: goal_displacement in sylva_core::cpu::hsm.

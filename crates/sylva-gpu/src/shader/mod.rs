@@ -35,6 +35,8 @@ pub const SKJERMO: &str = include_str!("skjermo.wgsl");
 pub const SKJERMO_STEP: &str = include_str!("skjermo_step.wgsl");
 /// Kernel: seam rotations from Skjermo's curves.
 pub const SKJERMO_ROTATIONS: &str = include_str!("skjermo_rotations.wgsl");
+/// Kernel: one level of Skjermo's rest orientation vectors, as the device rounds them.
+pub const SKJERMO_REST_ORIENT: &str = include_str!("skjermo_rest_orient.wgsl");
 /// Song's linearised tree (`HsmCluster`, …) and the rotation extraction.
 pub const HSM: &str = include_str!("hsm.wgsl");
 /// Kernel: HSM stage 1, per cluster (workgroup reduction).
@@ -80,6 +82,7 @@ pub const KERNELS: &[(&str, &[&str])] = &[
     ("akagi_integrate", &[QUAT, TREE, AKAGI, AKAGI_INTEGRATE]),
     ("skjermo_step", &[QUAT, TREE, NOISE, WIND, SKJERMO, SKJERMO_STEP]),
     ("skjermo_rotations", &[QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS]),
+    ("skjermo_rest_orient", &[QUAT, TREE, SKJERMO, SKJERMO_REST_ORIENT]),
     ("hsm_clusters", &[QUAT, NOISE, WIND, HSM, HSM_CLUSTERS]),
     ("hsm_goals", &[QUAT, HSM, HSM_GATHER, HSM_GOALS]),
     ("hsm_integrate", &[QUAT, HSM, HSM_ADVANCE, HSM_INTEGRATE]),
