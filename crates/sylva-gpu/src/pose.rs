@@ -497,13 +497,15 @@ impl GpuSkjermo {
         // The rest orientations as this device rounds them (a GPU that fuses multiply-adds
         // rounds the attachment frames differently from the CPU): with the CPU's, a step in
         // still air would move the stems by rounding errors instead of keeping the rest.
-        let orient = Self::rest_orientations(ctx, method)?;
+        let stems_buffer = upload(ctx, "skjermo stems", &method.stems)?;
+        let orient = Self::rest_orientations(ctx, &stems_buffer, method)?;
         let mut stems = method.stems.clone();
         for st in &mut stems {
             if st.parent != sylva_core::model::NONE {
                 st.parent_orient = orient[st.parent as usize];
             }
         }
+        ctx.queue.write_buffer(&stems_buffer, 0, bytemuck::cast_slice(&stems));
         let rest: Vec<RawSkjermoState> =
             orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect();
         Ok(Self {
@@ -512,7 +514,7 @@ impl GpuSkjermo {
             pose: GpuPose::new(ctx, tree)?,
             fields: wind_fields,
             waves: wind_waves,
-            stems: upload(ctx, "skjermo stems", &stems)?,
+            stems: stems_buffer,
             params: upload(ctx, "segment params", &method.segment_param)?,
             step: upload(ctx, "skjermo step", &[method.step_params(0.0)])?,
             state: [upload(ctx, "skjermo state a", &rest)?, upload(ctx, "skjermo state b", &rest)?],
@@ -524,14 +526,15 @@ impl GpuSkjermo {
     }
 
     /// The rest orientation vectors computed on the device: `skjermo_rest_orient` once per
-    /// stem depth, ping-pong (waits for the GPU).
+    /// stem depth, ping-pong, over the uploaded `stems` (whose parent orientations it does
+    /// not read; waits for the GPU).
     fn rest_orientations(
         ctx: &GpuContext,
+        stems: &wgpu::Buffer,
         method: &sylva_core::animate::skjermo::Skjermo,
     ) -> Result<Vec<[f32; 4]>, GpuError> {
         use crate::shader::{SKJERMO, SKJERMO_REST_ORIENT};
         let kernel = Kernel::cached(ctx, "skjermo_rest_orient", &[QUAT, TREE, SKJERMO, SKJERMO_REST_ORIENT]);
-        let stems = upload(ctx, "skjermo stems", &method.stems)?;
         let orient = [
             upload(ctx, "skjermo rest orientations a", &method.rest_orient)?,
             output::<[f32; 4]>(ctx, "skjermo rest orientations b", method.stems.len())?,
@@ -540,7 +543,7 @@ impl GpuSkjermo {
         let mut e = ctx.device.create_command_encoder(&Default::default());
         for level in 0..levels {
             let (from, to) = (&orient[level % 2], &orient[1 - level % 2]);
-            kernel.record(ctx, &mut e, &[&stems, from, to], method.stems.len() as u32);
+            kernel.record(ctx, &mut e, &[stems, from, to], method.stems.len() as u32);
         }
         ctx.queue.submit([e.finish()]);
         read_back(ctx, &orient[levels % 2], method.stems.len())

@@ -66,6 +66,10 @@ pub fn extract_rotation(a: Mat3, q: Quat, iterations: u32) -> Quat {
 pub fn rotation_step(r: Mat3, a: Mat3, eps: f32) -> Vec3 {
     let g = r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
     let tr = r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis);
+    let muller = g / (tr.abs() + eps);
+    if !(tr > 0.0 && muller.length_squared() < NEWTON_NEAR * NEWTON_NEAR) {
+        return muller;
+    }
     // Columns of B = A Rᵀ: bₖ = Σᵢ aᵢ rᵢ[k].
     let b0 = a.x_axis * r.x_axis.x + a.y_axis * r.y_axis.x + a.z_axis * r.z_axis.x;
     let b1 = a.x_axis * r.x_axis.y + a.y_axis * r.y_axis.y + a.z_axis * r.z_axis.y;
@@ -84,13 +88,7 @@ pub fn rotation_step(r: Mat3, a: Mat3, eps: f32) -> Vec3 {
     let c12 = h01 * h02 - h00 * h12;
     let c22 = h00 * h11 - h01 * h01;
     let det = h00 * c00 + h01 * c01 + h02 * c02;
-    let muller = g / (tr.abs() + eps);
-    if muller.length_squared() < NEWTON_NEAR * NEWTON_NEAR
-        && tr > 0.0
-        && h00 > 0.0
-        && c22 > 0.0
-        && det > 1e-4 * (tr * tr * tr)
-    {
+    if h00 > 0.0 && c22 > 0.0 && det > 1e-4 * (tr * tr * tr) {
         Vec3::new(
             c00 * g.x + c01 * g.y + c02 * g.z,
             c01 * g.x + c11 * g.y + c12 * g.z,

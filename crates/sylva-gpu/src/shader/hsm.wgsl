@@ -94,6 +94,10 @@ fn extract_rotation(a: mat3x3<f32>, q0: vec4<f32>, iterations: u32) -> vec4<f32>
 fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, eps: f32) -> vec3<f32> {
     let g = cross(r[0], a[0]) + cross(r[1], a[1]) + cross(r[2], a[2]);
     let tr = dot(r[0], a[0]) + dot(r[1], a[1]) + dot(r[2], a[2]);
+    let muller = g / (abs(tr) + eps);
+    if (!(tr > 0.0 && dot(muller, muller) < NEWTON_NEAR * NEWTON_NEAR)) {
+        return muller;
+    }
     let b0 = a[0] * r[0].x + a[1] * r[1].x + a[2] * r[2].x;
     let b1 = a[0] * r[0].y + a[1] * r[1].y + a[2] * r[2].y;
     let b2 = a[0] * r[0].z + a[1] * r[1].z + a[2] * r[2].z;
@@ -110,9 +114,7 @@ fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, eps: f32) -> vec3<f32> {
     let c12 = h01 * h02 - h00 * h12;
     let c22 = h00 * h11 - h01 * h01;
     let det = h00 * c00 + h01 * c01 + h02 * c02;
-    let muller = g / (abs(tr) + eps);
-    if (dot(muller, muller) < NEWTON_NEAR * NEWTON_NEAR && tr > 0.0 && h00 > 0.0 && c22 > 0.0
-        && det > 1e-4 * (tr * tr * tr)) {
+    if (h00 > 0.0 && c22 > 0.0 && det > 1e-4 * (tr * tr * tr)) {
         return vec3<f32>(
             c00 * g.x + c01 * g.y + c02 * g.z,
             c01 * g.x + c11 * g.y + c12 * g.z,
