@@ -19,19 +19,12 @@ use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 use serde::Serialize;
 use std::path::PathBuf;
-use sylva_core::animate::skjermo::{RawSkjermoState, RawSkjermoStem, SKJERMO_FIGURE, Skjermo, SkjermoParams};
+use sylva_core::animate::skjermo::{
+    BENCH_BINARY_TREE, BENCH_FOUR_SINES, RawSkjermoState, RawSkjermoStem, SKJERMO_FIGURE, Skjermo, SkjermoParams,
+};
+use sylva_core::animate::skjermo_lanes::{StateLanes, StemLanes};
 use sylva_core::wind::WindScene;
 use sylva_core::{Grammar, LSystemOptions};
-
-/// A binary tree: every stem one segment, two children at ±30°.
-pub const BINARY: &str = "axiom: A(1)\nA(l) -> F(l)[+(30)A(l*0.8)][-(30)/(90)A(l*0.8)]\n";
-
-/// The paper's wind: four sines (eqs. 11–14).
-pub const FOUR_SINES: &str = "[[field]]\nkind = \"sum_of_sines\"\nsharpness = 2.0\nwaves = [\n\
-    { amplitude = 4.0, direction_deg = 0.0, wavelength = 40.0, speed = 6.0 },\n\
-    { amplitude = 2.0, direction_deg = 30.0, wavelength = 17.0, speed = 4.0 },\n\
-    { amplitude = 1.0, direction_deg = -25.0, wavelength = 9.0, speed = 3.0 },\n\
-    { amplitude = 0.5, direction_deg = 60.0, wavelength = 5.0, speed = 2.0 },\n]\n";
 
 /// One row.
 #[derive(Debug, Clone, Serialize)]
@@ -42,8 +35,11 @@ pub struct SkjermoRow {
     pub paper_updates_per_s: Option<f64>,
     /// Our branches (stems).
     pub branches: usize,
-    /// Bytes read and written per update (stem constants and state in, state out).
+    /// Bytes read and written per update by the GPU kernel and the CPU reference (stem
+    /// constants and state in, state out).
     pub bytes_per_update: usize,
+    /// The same for the CPU fast path, whose lane groups hold fewer constants per stem.
+    pub cpu_bytes_per_update: usize,
     /// CPU fast path, updates/s.
     pub cpu: Option<Rate>,
     /// CPU reference kernel, updates/s.
@@ -63,9 +59,9 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     } else {
         vec![(16, Some(SKJERMO_FIGURE[0])), (18, Some(SKJERMO_FIGURE[1]))]
     };
-    let wind = WindScene::from_toml(FOUR_SINES, "four sines")?;
+    let wind = WindScene::from_toml(BENCH_FOUR_SINES, "four sines")?;
     let (fields, waves) = wind.pack();
-    let grammar = Grammar::parse(BINARY, "binary.lsys")?;
+    let grammar = Grammar::parse(BENCH_BINARY_TREE, "binary.lsys")?;
     let bar = ProgressBar::new(sizes.len() as u64).with_style(
         ProgressStyle::with_template("{msg:>10} [{bar:30}] {pos}/{len} rows, {elapsed}").expect("valid template"),
     );
@@ -79,6 +75,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         // Per stem: its constants and its and its parent's previous state read, its next
         // state written.
         let bytes = n * (std::mem::size_of::<RawSkjermoStem>() + 3 * std::mem::size_of::<RawSkjermoState>());
+        let cpu_bytes = m.lanes.len() * (std::mem::size_of::<StemLanes>() + 3 * std::mem::size_of::<StateLanes>());
         let (cpu, cpu_reference) = if env.time_cpu {
             let mut state = m.rest_state(&tree);
             let fast = measure(env.budget, |k| {
@@ -115,7 +112,8 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             paper_updates_per_s: paper.map(|p| p.1),
             branches: n,
             bytes_per_update: bytes,
-            cpu_bandwidth_fraction: cpu.map(|r| r.median * bytes as f64 / env.machine.cpu_bandwidth),
+            cpu_bytes_per_update: cpu_bytes,
+            cpu_bandwidth_fraction: cpu.map(|r| r.median * cpu_bytes as f64 / env.machine.cpu_bandwidth),
             gpu_bandwidth_fraction: gpu.zip(env.machine.gpu_bandwidth).map(|(r, b)| r.median * bytes as f64 / b),
             cpu,
             cpu_reference,
@@ -139,7 +137,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     let mut md = markdown_head("Skjermo: branches updated per second", "skjermo", env.machine);
     md += "Updates per second, median (slowest–fastest). Wind: four sines (the paper's setting). The paper: \
            GeForce 7900 GTX, the wind animation shader alone.\n\n";
-    md += "| paper branches | paper updates/s | branches | MB/update | CPU updates/s | CPU reference kernel | CPU / paper | CPU % of bandwidth | GPU updates/s | GPU / paper | GPU % of bandwidth | GPU / CPU |\n";
+    md += "| paper branches | paper updates/s | branches | MB/update (CPU / GPU) | CPU updates/s | CPU reference kernel | CPU / paper | CPU % of bandwidth | GPU updates/s | GPU / paper | GPU % of bandwidth | GPU / CPU |\n";
     md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let over = |r: Option<Rate>, p: Option<f64>| match (r, p) {
         (Some(r), Some(p)) => format!("{:.2}", r.median / p),
@@ -148,10 +146,11 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     let pct = |f: Option<f64>| f.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f));
     for r in &out {
         md += &format!(
-            "| {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {:.1} / {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.paper_branches.map_or("–".into(), |b| b.to_string()),
             r.paper_updates_per_s.map_or("–".into(), |p| format!("{p:.0}")),
             r.branches,
+            r.cpu_bytes_per_update as f64 / 1e6,
             r.bytes_per_update as f64 / 1e6,
             rate(r.cpu),
             rate(r.cpu_reference),

@@ -10,8 +10,8 @@ use std::time::Duration;
 use sylva_core::species::SpeciesSource;
 use sylva_core::{Grammar, LSystemOptions};
 
-/// A binary tree of 2^20 − 1 = 1,048,575 segments after 20 steps.
-pub const MILLION: &str = "axiom: A(1)\nA(l) -> F(l)[+(30)A(l*0.8)][-(30)/(90)A(l*0.8)]\n";
+/// A binary tree of 2^20 − 1 = 1,048,575 segments after 20 steps (Skjermo's benchmark tree).
+use sylva_core::animate::skjermo::BENCH_BINARY_TREE as MILLION;
 
 fn one_core<T: Send>(f: impl FnOnce() -> T + Send) -> T {
     rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(f)

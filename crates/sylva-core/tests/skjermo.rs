@@ -225,3 +225,46 @@ fn every_instruction_set_level_gives_the_same_bits() {
         }
     }
 }
+
+/// Regression for the AVX2 gather: a lane group whose parents lie outside the state (lane
+/// groups edited by hand) reads them as none at every instruction set level, as a trunk does:
+/// no out-of-bounds read, and the same bits as the same group with `NONE` parents.
+#[test]
+fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
+    use sylva_core::animate::skjermo_lanes::{StateLanes, step};
+    use sylva_core::model::NONE;
+    use sylva_core::simd::{Level, detected};
+    let t = tree("quaking_aspen");
+    let m = Skjermo::new(&t, SkjermoParams::default());
+    let (f, w) = constant(12.0).pack();
+    let groups = m.lanes.len();
+    let outside = [16 * groups as u32, 16 * groups as u32 + 15, u32::MAX - 1, 1 << 31];
+    let mut edited = m.lanes.clone();
+    let mut none = m.lanes.clone();
+    for (g, (e, n)) in edited.iter_mut().zip(&mut none).enumerate().skip(1).step_by(3) {
+        for l in 0..16 {
+            e.parent[l] = outside[(g + l) % outside.len()];
+            n.parent[l] = NONE;
+        }
+    }
+    let bits = |s: &[StateLanes]| -> Vec<u32> {
+        s.iter()
+            .flat_map(|g| g.delta.iter().chain([&g.orient]).flat_map(|v| [v.x, v.y, v.z]))
+            .flat_map(|v| v.to_array().map(f32::to_bits))
+            .collect()
+    };
+    let run = |lanes: &[_], level: Level| {
+        let mut s = m.rest_state(&t).lanes;
+        let mut next = s.clone();
+        for k in 1..=20 {
+            step(level, &f, &w, lanes, &s, m.lane_step(k as f32 / 60.0), &mut next);
+            std::mem::swap(&mut s, &mut next);
+        }
+        bits(&s)
+    };
+    let want = run(&none, Level::Baseline);
+    assert_ne!(want, run(&m.lanes, Level::Baseline), "the edit should change the result");
+    for level in [Level::Baseline, detected()] {
+        assert_eq!(run(&edited, level), want, "{level:?}");
+    }
+}

@@ -56,6 +56,17 @@ impl Default for SkjermoParams {
 /// animation shader alone, with 256² textures (65,536 branches) and 512² (262,144).
 pub const SKJERMO_FIGURE: [(usize, f64); 2] = [(65_536, 600.0), (262_144, 180.0)];
 
+/// The benchmark's L-system (`sylva bench skjermo`): a binary tree, every stem one segment,
+/// two children at ±30° (16 iterations: 65,535 stems; 18: 262,143).
+pub const BENCH_BINARY_TREE: &str = "axiom: A(1)\nA(l) -> F(l)[+(30)A(l*0.8)][-(30)/(90)A(l*0.8)]\n";
+
+/// The benchmark's wind, the paper's setting: four sines (eqs. 11–14).
+pub const BENCH_FOUR_SINES: &str = "[[field]]\nkind = \"sum_of_sines\"\nsharpness = 2.0\nwaves = [\n\
+    { amplitude = 4.0, direction_deg = 0.0, wavelength = 40.0, speed = 6.0 },\n\
+    { amplitude = 2.0, direction_deg = 30.0, wavelength = 17.0, speed = 4.0 },\n\
+    { amplitude = 1.0, direction_deg = -25.0, wavelength = 9.0, speed = 3.0 },\n\
+    { amplitude = 0.5, direction_deg = 60.0, wavelength = 5.0, speed = 2.0 },\n]\n";
+
 /// Per-stem constants, 160 bytes. WGSL: `SkjermoStem` in `skjermo.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]

@@ -15,8 +15,9 @@ pub use crate::simd::LANES;
 /// Sixteen `f32` lanes.
 pub type V = crate::simd::F32x16;
 
-/// Three lanes of sixteen: x, y and z of sixteen vectors.
+/// Three lanes of sixteen: x, y and z of sixteen vectors (in that order in memory).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[repr(C)]
 pub struct V3 {
     /// x of each lane.
     pub x: V,
@@ -62,13 +63,14 @@ impl V3 {
         // so the rest frames it builds are reproduced bit for bit.
         Self::select(ok, self.scale(V::ONE / safe), fallback)
     }
-    /// glam's `normalize_or_zero`.
+    /// glam's `normalize_or_zero() * len` with one division, `self · (len / |self|)`: zero
+    /// where `|self|` is zero or not finite.
     #[inline(always)]
-    pub fn normalize_or_zero(self) -> Self {
+    pub fn with_length(self, len: V) -> Self {
         let l = self.length();
         let ok = l.cmp_gt(V::ZERO) & l.is_finite();
         let safe = ok.blend(l, V::ONE);
-        Self::select(ok, self.scale(V::ONE / safe), Self::ZERO)
+        Self::select(ok, self.scale(len / safe), Self::ZERO)
     }
     /// glam's `any_orthogonal_vector`.
     #[inline(always)]
