@@ -189,6 +189,16 @@ fn match_cluster(
 #[inline(always)]
 fn lane_sums(run: &[RawHsmSlot], displacement: &[[f32; 4]], t: usize) -> [Vec3A; 4] {
     let mut acc = [Vec3A::ZERO; 4];
+    if run.len() <= LANES {
+        // At most one slot per lane (most clusters): the same additions without the
+        // strided iterator.
+        if let Some(s) = run.get(t) {
+            for (a, v) in acc.iter_mut().zip(slot_terms(displacement[s.particle as usize], s)) {
+                *a += v;
+            }
+        }
+        return acc;
+    }
     for s in run.iter().skip(t).step_by(LANES) {
         for (a, v) in acc.iter_mut().zip(slot_terms(displacement[s.particle as usize], s)) {
             *a += v;
