@@ -64,13 +64,15 @@ impl V3 {
         Self::select(ok, self.scale(V::ONE / safe), fallback)
     }
     /// glam's `normalize_or_zero() * len` with one division, `self · (len / |self|)`: zero
-    /// where `|self|` is zero or not finite.
+    /// where `|self|` is zero or not finite, or the ratio is not (a vector so short that
+    /// `len / |self|` overflows), so a finite `len` always gives a finite vector.
     #[inline(always)]
     pub fn with_length(self, len: V) -> Self {
         let l = self.length();
-        let ok = l.cmp_gt(V::ZERO) & l.is_finite();
-        let safe = ok.blend(l, V::ONE);
-        Self::select(ok, self.scale(len / safe), Self::ZERO)
+        let positive = l.cmp_gt(V::ZERO);
+        let ratio = len / positive.blend(l, V::ONE);
+        let ok = positive & l.is_finite() & ratio.is_finite();
+        Self::select(ok, self.scale(ratio), Self::ZERO)
     }
     /// glam's `any_orthogonal_vector`.
     #[inline(always)]
@@ -191,6 +193,31 @@ mod tests {
         }
         // 2e-6 from the polynomial on [−π, π]; the reduction adds the rounding of x itself.
         assert!(worst < 4e-6, "worst error {worst}");
+    }
+
+    /// Regression: `with_length` of a vector so short that `len / |v|` overflows gave
+    /// infinities and NaN (0 · ∞); it gives zero there, as glam's `normalize_or_zero`.
+    #[test]
+    fn with_length_stays_finite_for_tiny_zero_and_infinite_vectors() {
+        let tiny = f32::from_bits(1); // the smallest subnormal
+        let cases = [
+            (Vec3::new(3.0, 4.0, 0.0), 10.0, Some(Vec3::new(6.0, 8.0, 0.0))),
+            (Vec3::new(tiny, 0.0, 0.0), 5.0, None),
+            (Vec3::new(1e-20, 0.0, -1e-20), 1e30, None),
+            (Vec3::ZERO, 2.0, Some(Vec3::ZERO)),
+            (Vec3::new(f32::INFINITY, 0.0, 0.0), 1.0, Some(Vec3::ZERO)),
+            (Vec3::new(f32::NAN, 1.0, 0.0), 1.0, Some(Vec3::ZERO)),
+            (Vec3::new(1.0, 0.0, 0.0), f32::NAN, Some(Vec3::ZERO)),
+        ];
+        for (v, len, want) in cases {
+            let got = V3::splat(v).with_length(V::splat(len)).lane(0);
+            assert!(got.is_finite(), "{v} · {len}: {got}");
+            if let Some(w) = want {
+                assert!((got - w).length() <= 1e-6 * (1.0 + w.length()), "{v} · {len}: {got} vs {w}");
+            } else {
+                assert!(got.length() <= len * (1.0 + 1e-6), "{v} · {len}: {got}");
+            }
+        }
     }
 
     #[test]
