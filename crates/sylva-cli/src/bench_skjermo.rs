@@ -135,8 +135,14 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     bar.finish_and_clear();
 
     let mut md = markdown_head("Skjermo: branches updated per second", "skjermo", env.machine);
-    md += "Updates per second, median (slowest–fastest). Wind: four sines (the paper's setting). The paper: \
-           GeForce 7900 GTX, the wind animation shader alone.\n\n";
+    md += &format!(
+        "Updates per second, median (slowest–fastest). Wind: four sines (the paper's setting). The paper: \
+         GeForce 7900 GTX, the wind animation shader alone. MB/update: stem constants and state read, state \
+         written; the CPU fast path's lane groups hold {} bytes of constants per stem, the GPU's (and the \
+         reference kernel's) records {}. Over 100 % of bandwidth: part of the working set stays in cache.\n\n",
+        std::mem::size_of::<StemLanes>() / sylva_core::animate::skjermo_lanes::LANES,
+        std::mem::size_of::<RawSkjermoStem>()
+    );
     md += "| paper branches | paper updates/s | branches | MB/update (CPU / GPU) | CPU updates/s | CPU reference kernel | CPU / paper | CPU % of bandwidth | GPU updates/s | GPU / paper | GPU % of bandwidth | GPU / CPU |\n";
     md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let over = |r: Option<Rate>, p: Option<f64>| match (r, p) {
