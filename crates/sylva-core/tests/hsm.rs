@@ -141,6 +141,58 @@ fn elongated_clusters_reach_their_rotation_in_two_iterations() {
     }
 }
 
+/// Regression: the rotation step switched between Newton's and Müller's at thresholds (the
+/// length of Müller's step, `det H`) and the iteration stopped below |ω| < 2e-6, so a
+/// rounding difference that crossed one became a jump, and two runs 1e-10 m/s apart ended
+/// 1e-5 × height apart after 1,000 steps (a GPU 5e-3). Now the step is blended: sweeping an
+/// elongated cluster's turn finely across the old switch (|μ| = 0.05) and the blend's end
+/// (0.1), and its thinness across `det H = 10⁻⁴ (tr B)³`, the rotation changes by no more
+/// than a few times the input's change. A switched step jumps by `|H⁻¹ g − μ|`, here ≥ 3e-3
+/// rad per 1e-5 of turn, which the bound excludes.
+#[test]
+fn rotation_extraction_has_no_jumps() {
+    let mut rng = ChaCha8Rng::seed_from_u64(77);
+    let axis = Vec3::new(0.3, 1.0, -0.2).normalize();
+    for _ in 0..20 {
+        let f = Mat3::from_quat(random_rotation(&mut rng, 3.1));
+        let thin = rng.random_range(0.05f32..0.3);
+        let s = f * Mat3::from_diagonal(Vec3::new(1.0, thin * thin, 0.5 * thin * thin)) * f.transpose();
+        let turn_axis = (axis + f.x_axis * rng.random_range(-0.5..0.5)).normalize();
+        // Müller's step is about (turn × the stretch's scale) / tr: sweep the turn over the blend.
+        let mut last: Option<(f32, Quat)> = None;
+        let n = 4000;
+        for k in 0..=n {
+            let turn = 0.02 + 0.16 * k as f32 / n as f32;
+            let a = Mat3::from_quat(Quat::from_axis_angle(turn_axis, turn)) * s;
+            let q = extract_rotation(a, Quat::IDENTITY, 1);
+            if let Some((t0, q0)) = last {
+                let dq = 2.0 * (q - q0).length().min((q + q0).length());
+                assert!(dq <= 8.0 * (turn - t0), "turn {t0} → {turn}: the rotation jumped by {dq} rad");
+            }
+            last = Some((turn, q));
+        }
+    }
+    // Thinness across the positive-definite blend: det H / (tr B)³ from 5e-5 to 4e-4, turned
+    // 0.02 rad about the long axis, where Newton's and Müller's steps differ by ~0.02 rad.
+    // Formed from A, the turn about the axis is known only to ~ε/thinness (≤ 2e-3 rad here).
+    for _ in 0..20 {
+        let f = Mat3::from_quat(random_rotation(&mut rng, 3.1));
+        let r = Quat::from_axis_angle(f.x_axis, 0.02);
+        let mut last: Option<(f32, Quat)> = None;
+        let n = 4000;
+        for k in 0..=n {
+            let thin = 5e-5 + 3.5e-4 * k as f32 / n as f32;
+            let a = Mat3::from_quat(r) * f * Mat3::from_diagonal(Vec3::new(1.0, thin, 0.0)) * f.transpose();
+            let q = extract_rotation(a, Quat::IDENTITY, 1);
+            if let Some((t0, q0)) = last {
+                let dq = 2.0 * (q - q0).length().min((q + q0).length());
+                assert!(dq <= 5e-3, "thinness {t0} → {thin}: the rotation jumped by {dq} rad");
+            }
+            last = Some((thin, q));
+        }
+    }
+}
+
 /// A horizontal cantilever of six segments under bare gravity.
 fn cantilever() -> Tree {
     let mut b = TreeBuilder::default();

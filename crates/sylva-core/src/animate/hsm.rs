@@ -58,14 +58,17 @@
 //! depend on the step, and the clamp at 1 keeps Müller's unconditional stability.
 //!
 //! **Rotation**: `R` is extracted by the iterative method of Müller, Bender, Chentanez &
-//! Macklin (2016), warm-started from the last step's R, `R ← exp(ω) R`, with a Newton step:
-//! `ω = H⁻¹ g`, `g = Σ rᵢ × aᵢ`, `H = tr(B) I − sym(B)`, `B = Apq Rᵀ` (the gradient and
-//! Hessian of `tr(Rᵀ Apq)`), and Müller's `ω = g / (|tr B| + ε)` where `H` is not safely
+//! Macklin (2016), warm-started from the last step's R, `R ← rot(ω) R` (the unit
+//! quaternion along `(ω/2, 1)`, no trigonometry), with a Newton step: `ω = H⁻¹ g`,
+//! `g = Σ rᵢ × aᵢ`, `H = tr(B) I − sym(B)`, `B = Apq Rᵀ` (the gradient and Hessian of
+//! `tr(Rᵀ Apq)`), blended toward Müller's `ω = g / (|tr B| + ε)` where `H` is not safely
 //! positive definite (see [`crate::cpu::hsm::rotation_step`]). It yields a rotation for any
 //! finite `Apq` — flat (leaf), collinear, inverted or zero clusters included — never NaN,
-//! and reaches the optimal rotation (|ω| < 2e-6) in 1–2 iterations per step warm, elongated
-//! clusters included, where Müller's step alone turns them about their long axis by only
-//! `(σ₂ + σ₃) / (σ₁ + σ₂ + σ₃)` of the way per iteration.
+//! and reaches the optimal rotation in 1–2 iterations per step warm, elongated clusters
+//! included, where Müller's step alone turns them about their long axis by only
+//! `(σ₂ + σ₃) / (σ₁ + σ₂ + σ₃)` of the way per iteration. R is a continuous function of
+//! the particles (no threshold switches a step on or off), so rounding differences between
+//! the CPU and a GPU stay rounding-sized (see [`crate::cpu::hsm::extract_rotation`]).
 //!
 //! # Pose
 //! Each segment turns by its cluster's R (the pose seam's accumulated rotation D = R), and
@@ -718,9 +721,10 @@ impl HsmLayout {
             let mut aqq = DMat3::ZERO;
             for &p in run {
                 let m = b.layout.mass[p as usize] as f64;
-                let q = b.pos[p as usize].as_dvec3() - cm;
+                // Aqq of the offsets as stored.
+                let qf = (b.pos[p as usize].as_dvec3() - cm).as_vec3();
+                let q = qf.as_dvec3();
                 aqq += DMat3::from_cols(q * q.x, q * q.y, q * q.z) * m;
-                let qf = q.as_vec3();
                 slots.push(RawHsmSlot { q: qf.to_array(), particle: p });
             }
             let det = aqq.determinant();

@@ -73,29 +73,31 @@ fn quat_to_mat3(q: vec4<f32>) -> mat3x3<f32> {
 }
 
 // The rotation of `a` (Müller, Bender, Chentanez & Macklin 2016) with a Newton step,
-// warm-started from `q0`; never NaN (see the CPU twin `extract_rotation`).
+// warm-started from `q0`; never NaN, and continuous in `a` and `q0`: every iteration runs
+// and the steps are blended, not switched (see the CPU twin `extract_rotation`).
 fn extract_rotation(a: mat3x3<f32>, q0: vec4<f32>, iterations: u32) -> vec4<f32> {
     var q = q0;
     let eps = 1e-6 * (length(a[0]) + length(a[1]) + length(a[2])) + 1e-30;
     for (var k = 0u; k < iterations; k++) {
         let r = quat_to_mat3(q);
-        let omega = rotation_step(r, a, eps);
-        let w = length(omega);
-        if (w < 2e-6) {
-            break;
-        }
-        q = normalize(quat_mul(quat_axis_angle(omega / w, w), q));
+        let g = cross(r[0], a[0]) + cross(r[1], a[1]) + cross(r[2], a[2]);
+        // rot(ω): the unit quaternion along (ω/2, 1), no sin or cos (see the CPU twin).
+        let half = rotation_step(r, a, g, eps) * 0.5;
+        q = normalize(quat_mul(vec4<f32>(half, 1.0), q));
     }
     return q;
 }
 
-// One step: Newton's H⁻¹ g with H = tr(B) I − sym(B), B = A Rᵀ, near the optimum where H is
-// safely positive definite, else Müller's g / (|tr B| + ε). Twin: rotation_step in sylva_core::cpu::hsm.
-fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, eps: f32) -> vec3<f32> {
-    let g = cross(r[0], a[0]) + cross(r[1], a[1]) + cross(r[2], a[2]);
+// One step: Müller's μ = g / (|tr B| + ε) blended toward Newton's H⁻¹ g, H = tr(B) I − sym(B),
+// B = A Rᵀ, by s = s_near · s_pd (near the optimum, H safely positive definite), given
+// g = Σ rᵢ × aᵢ.
+// Twin: rotation_step in sylva_core::cpu::hsm.
+fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, g: vec3<f32>, eps: f32) -> vec3<f32> {
     let tr = dot(r[0], a[0]) + dot(r[1], a[1]) + dot(r[2], a[2]);
     let muller = g / (abs(tr) + eps);
-    if (!(tr > 0.0 && dot(muller, muller) < NEWTON_NEAR * NEWTON_NEAR)) {
+    let near = NEWTON_NEAR * NEWTON_NEAR;
+    let s_near = min((4.0 * near - dot(muller, muller)) / (3.0 * near), 1.0);
+    if (!(tr > 0.0 && s_near > 0.0)) {
         return muller;
     }
     let b0 = a[0] * r[0].x + a[1] * r[1].x + a[2] * r[2].x;
@@ -114,17 +116,24 @@ fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, eps: f32) -> vec3<f32> {
     let c12 = h01 * h02 - h00 * h12;
     let c22 = h00 * h11 - h01 * h01;
     let det = h00 * c00 + h01 * c01 + h02 * c02;
-    if (h00 > 0.0 && c22 > 0.0 && det > 1e-4 * (tr * tr * tr)) {
-        return vec3<f32>(
-            c00 * g.x + c01 * g.y + c02 * g.z,
-            c01 * g.x + c11 * g.y + c12 * g.z,
-            c02 * g.x + c12 * g.y + c22 * g.z,
-        ) / det;
+    let thin = 1e-4 * (tr * tr * tr);
+    if (!(h00 > 0.0 && c22 > 0.0 && det > thin)) {
+        return muller;
     }
-    return muller;
+    var s_pd = 1.0;
+    if (thin > 0.0) {
+        s_pd = min(det / thin - 1.0, 1.0);
+    }
+    let newton = vec3<f32>(
+        c00 * g.x + c01 * g.y + c02 * g.z,
+        c01 * g.x + c11 * g.y + c12 * g.z,
+        c02 * g.x + c12 * g.y + c22 * g.z,
+    ) / det;
+    return muller + (newton - muller) * (s_near * s_pd);
 }
 
-// Müller's step below which rotation_step takes Newton's, rad (NEWTON_NEAR on the CPU).
+// Length of Müller's step below which rotation_step takes Newton's whole, rad (blended up
+// to twice this; NEWTON_NEAR on the CPU).
 const NEWTON_NEAR: f32 = 0.05;
 
 // A cluster's goal for rest offset q, as a displacement from rest: (T q − q) + (c − c⁰).

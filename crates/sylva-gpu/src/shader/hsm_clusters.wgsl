@@ -30,6 +30,10 @@ fn main(
         return;
     }
     let inf = info[c];
+    // The shift at the last substep, subtracted from every displacement (see the CPU twin's
+    // slot_terms: Σ m q = 0, so Apq is unchanged, and the terms keep the cluster's size).
+    let st0 = state[c].transform;
+    let sp = vec3<f32>(st0[0].w, st0[1].w, st0[2].w);
     var sm = vec3<f32>(0.0);
     var a0 = vec3<f32>(0.0);
     var a1 = vec3<f32>(0.0);
@@ -38,7 +42,7 @@ fn main(
         let s = slots[inf.slot_offset + j];
         let x = displacement[s.particle];
         let m = x.w;
-        let u = x.xyz;
+        let u = x.xyz - sp;
         let q = s.q;
         sm += u * m;
         let d = u + q;
@@ -65,7 +69,7 @@ fn main(
     }
     let cl = clusters[c];
     let c0 = cl.rest_cm.xyz;
-    let shift = red_m[0] / cl.mass;
+    let shift = sp + red_m[0] / cl.mass;
     let cm = c0 + shift;
     let apq = mat3x3<f32>(red_a0[0], red_a1[0], red_a2[0]);
     let q = extract_rotation(apq, state[c].rotation, step.polar_iterations);
