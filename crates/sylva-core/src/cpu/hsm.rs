@@ -53,15 +53,13 @@ pub fn extract_rotation(a: Mat3, q: Quat, iterations: u32) -> Quat {
     let eps = 1e-6 * (a.x_axis.length() + a.y_axis.length() + a.z_axis.length()) + 1e-30;
     for _ in 0..iterations {
         let r = Mat3::from_quat(q);
-        let g = r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
-        let half = rotation_step(r, a, g, eps) * 0.5;
+        let half = rotation_step(r, a, eps) * 0.5;
         q = (Quat::from_xyzw(half.x, half.y, half.z, 1.0) * q).normalize();
     }
     q
 }
 
-/// One step `ω` of [`extract_rotation`] from rotation `r` toward the rotation of `a`, given
-/// the gradient `g = Σ rᵢ × aᵢ`.
+/// One step `ω` of [`extract_rotation`] from rotation `r` toward the rotation of `a`.
 ///
 /// `tr(Rᵀ exp(ω̂)ᵀ A) = tr B + ω · g − ½ ωᵀ H ω + O(|ω|³)` with `B = A Rᵀ`,
 /// `g = Σ rᵢ × aᵢ` and `H = tr(B) I − sym(B)`, so the maximum of the quadratic model is at
@@ -80,7 +78,8 @@ pub fn extract_rotation(a: Mat3, q: Quat, iterations: u32) -> Quat {
 /// So `ω` is a continuous function of `r` and `a` (see [`extract_rotation`] for why that
 /// matters). WGSL: `rotation_step` in `hsm.wgsl`, the same operations in the same order.
 #[inline(always)]
-pub fn rotation_step(r: Mat3, a: Mat3, g: Vec3, eps: f32) -> Vec3 {
+pub fn rotation_step(r: Mat3, a: Mat3, eps: f32) -> Vec3 {
+    let g = r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
     let tr = r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis);
     let muller = g / (tr.abs() + eps);
     let near = NEWTON_NEAR * NEWTON_NEAR;

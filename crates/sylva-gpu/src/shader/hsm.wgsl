@@ -80,19 +80,18 @@ fn extract_rotation(a: mat3x3<f32>, q0: vec4<f32>, iterations: u32) -> vec4<f32>
     let eps = 1e-6 * (length(a[0]) + length(a[1]) + length(a[2])) + 1e-30;
     for (var k = 0u; k < iterations; k++) {
         let r = quat_to_mat3(q);
-        let g = cross(r[0], a[0]) + cross(r[1], a[1]) + cross(r[2], a[2]);
         // rot(ω): the unit quaternion along (ω/2, 1), no sin or cos (see the CPU twin).
-        let half = rotation_step(r, a, g, eps) * 0.5;
+        let half = rotation_step(r, a, eps) * 0.5;
         q = normalize(quat_mul(vec4<f32>(half, 1.0), q));
     }
     return q;
 }
 
 // One step: Müller's μ = g / (|tr B| + ε) blended toward Newton's H⁻¹ g, H = tr(B) I − sym(B),
-// B = A Rᵀ, by s = s_near · s_pd (near the optimum, H safely positive definite), given
-// g = Σ rᵢ × aᵢ.
+// B = A Rᵀ, g = Σ rᵢ × aᵢ, by s = s_near · s_pd (near the optimum, H safely positive definite).
 // Twin: rotation_step in sylva_core::cpu::hsm.
-fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, g: vec3<f32>, eps: f32) -> vec3<f32> {
+fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, eps: f32) -> vec3<f32> {
+    let g = cross(r[0], a[0]) + cross(r[1], a[1]) + cross(r[2], a[2]);
     let tr = dot(r[0], a[0]) + dot(r[1], a[1]) + dot(r[2], a[2]);
     let muller = g / (abs(tr) + eps);
     let near = NEWTON_NEAR * NEWTON_NEAR;
