@@ -4,6 +4,7 @@ use glam::{DQuat, DVec3, Mat3, Quat, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sylva_core::animate::Pose;
+use sylva_core::animate::akagi::max_tip_displacement;
 use sylva_core::animate::hsm::{FIXED, Hsm, HsmLayout, HsmParams, HsmState, RawHsmClusterState};
 use sylva_core::cpu::hsm::{extract_rotation, hsm_clusters, hsm_goals};
 use sylva_core::species::{PRESETS, SpeciesSource};
@@ -232,6 +233,58 @@ fn a_cantilever_sags_the_same_whatever_the_substeps() {
         let d = (w[1] - w[0]).length();
         assert!(d <= 0.02 * last.length(), "sag changes by {d} m between substep counts: {sags:?}");
     }
+}
+
+/// Regression, named after what broke: each cluster's α was clamped at 1 *before* a shared
+/// particle's goals were averaged, so every cluster stiffer than `1/h²` had an equal say, a
+/// thick stem held the ring it shares with a twig no better than the twig did, and the
+/// stochastic bush (3 cm stems of 8 GPa wood, ~50× stiffer than a 240 Hz step holds that
+/// way) lay down in gusty wind: segment ends 2.0 m from rest on a 2.3 m bush, and with a
+/// tenth of the wood's stiffness it bent *less* (1.4 m). With the mean weighted by `k h²`
+/// (see `cpu::hsm::MAX_WEIGHT`), its segment ends stay within a tenth of its height, and
+/// softer wood bends it more.
+#[test]
+fn a_stiff_bush_does_not_lie_down_in_gusty_wind() {
+    let t = tree("stochastic_bush");
+    let wood = most_bending(&t, 1.0);
+    let soft = most_bending(&t, 0.1);
+    println!(
+        "bush of {:.2} m: segment ends up to {wood:.3} m from rest, {soft:.3} m with a tenth of the stiffness",
+        t.height()
+    );
+    assert!(wood > 1e-3, "the bush did not move: {wood} m");
+    assert!(wood < 0.1 * t.height(), "the bush bends {wood} m, more than a tenth of its {} m", t.height());
+    assert!(soft > 1.5 * wood, "a tenth of the stiffness bends it {soft} m, against {wood} m");
+}
+
+/// The largest distance of any segment end from rest over 4 s of `gusty` at 60 frames/s,
+/// with the wood's stiffness scaled by `stiffness_scale`.
+fn most_bending(t: &Tree, stiffness_scale: f32) -> f32 {
+    let (f, w) = WindScene::resolve("gusty").unwrap().pack();
+    let h = Hsm::new(t, HsmParams { stiffness_scale, ..Default::default() }).unwrap();
+    let mut s = h.rest_state();
+    let mut most = 0.0f32;
+    for k in 0..240 {
+        h.step(&f, &w, &mut s, 1.0 / 60.0);
+        if k % 6 == 5 {
+            most = most.max(max_tip_displacement(t, &h.pose(t, &s)));
+        }
+    }
+    most
+}
+
+/// Regression, named after what broke: with the weights unbounded past 1, a thin lateral
+/// whose rate is high only because it is light pulled the trunk rings it overlaps at that
+/// rate and outweighed the trunk there, and monopodial's trunk followed its laterals: tips
+/// 3.0 m from rest in gusty wind on a 9.8 m tree (0.24 m with every weight clamped at 1).
+/// A weight now passes 1 only up to the smallest rate on its path to the root.
+#[test]
+fn light_laterals_do_not_drag_a_monopodial_trunk() {
+    let t = tree("monopodial");
+    let most = most_bending(&t, 1.0);
+    println!("monopodial of {:.2} m: segment ends up to {most:.3} m from rest", t.height());
+    assert!(most > 1e-3, "the tree did not move: {most} m");
+    assert!(most < 0.05 * t.height(), "segment ends {most} m from rest, more than 5 % of {} m", t.height());
 }
 
 #[test]

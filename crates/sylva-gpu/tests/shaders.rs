@@ -470,3 +470,27 @@ fn deformer_structs_match_their_wgsl_twins() {
         ],
     );
 }
+
+/// A WGSL module-scope `const NAME: f32 = literal;`, from naga's parse.
+fn wgsl_f32_const(src: &str, name: &str) -> f32 {
+    let module = parse(src, name);
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no const {name}"));
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::F32(v)) => v,
+        ref e => panic!("{name} is not an f32 literal: {e:?}"),
+    }
+}
+
+/// HSM's tuning constants are written twice, in `cpu/hsm.rs` and in `hsm.wgsl`: the same
+/// values on both sides.
+#[test]
+fn hsm_constants_match_their_cpu_twins() {
+    use sylva_core::cpu::hsm::{MAX_WEIGHT, NEWTON_NEAR};
+    let src = compose(&[sylva_gpu::shader::QUAT, sylva_gpu::shader::HSM]);
+    assert_eq!(wgsl_f32_const(&src, "NEWTON_NEAR"), NEWTON_NEAR);
+    assert_eq!(wgsl_f32_const(&src, "MAX_WEIGHT"), MAX_WEIGHT);
+}

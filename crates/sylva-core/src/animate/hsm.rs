@@ -33,10 +33,10 @@
 //! 1. `hsm_clusters` (one GPU workgroup per cluster, shared-memory reduction): centre of
 //!    mass `c`, `Apq = Σ m (x − c⁰) qᵀ`, the rotation `R` of `Apq` (see below), the goal
 //!    transform `T = β Â + (1 − β) R` with `Â = Apq Aqq⁻¹ / det^⅓` (Müller's linear blend;
-//!    `β = 0` is pure rotation), α of the cluster and the wind at `c`.
+//!    `β = 0` is pure rotation), the cluster's weight `w = k h²` and the wind at `c`.
 //! 2. Synchronisation: the end of the dispatch.
 //! 3. `hsm_goals` (per particle): over the clusters sharing it, `g_c = T_c q + c_c`; the goal
-//!    is the α-weighted mean `ĝ = Σ α_c g_c / Σ α_c` with `ᾱ = min(1, Σ α_c)` (Table 1
+//!    is the weighted mean `ĝ = Σ w_c g_c / Σ w_c` with `ᾱ = min(1, Σ w_c)` (Table 1
 //!    steps 3–4 take `Σ α / n`; with n, a ring shared by twenty leaves had its segment's
 //!    hold diluted twentyfold).
 //! 4. `hsm_integrate` (per particle): `v += ᾱ (ĝ − x) / h + h g` (Table 1 steps 5–6; a
@@ -52,10 +52,18 @@
 //! The GPU twins (`sylva_gpu::hsm::GpuHsm`) run the same stages over the same buffers, every
 //! substep of a step in one submission.
 //!
-//! **Stiffness** is a rate, not a per-step fraction: `α = min(1, k h²)` with `k` in 1/s²
-//! (per level, trunk stiffest). Then `v += k h (g − x)` is a spring of angular frequency √k
-//! integrated by symplectic Euler, the static sag under gravity (`x − g = g/k`) does not
-//! depend on the step, and the clamp at 1 keeps Müller's unconditional stability.
+//! **Stiffness** is a rate, not a per-step fraction: a cluster's weight is `w = k h²` with
+//! `k` in 1/s² (from the wood's `E·I/L`, trunk stiffest). Where `Σ w < 1`,
+//! `v += k h (g − x)` is a spring of angular frequency √k integrated by symplectic Euler and
+//! the static sag under gravity (`x − g = g/k`) does not depend on the step; the clamp
+//! `ᾱ ≤ 1` keeps Müller's unconditional stability. The weights themselves may pass 1 (up
+//! to the smallest rate on the cluster's path to the root): a shared particle's goal is
+//! where its clusters' spring forces balance, so a thick stem holds the ring it shares
+//! with a twig or a leaf (see [`crate::cpu::hsm::MAX_WEIGHT`]). What the clamp still
+//! limits: a joint between two clusters that are both stiffer than `1/h²` resists bending
+//! by about `m L² / h²` (its shared particles' mass and lever), less than the wood of
+//! short, thick segments. Such trees bend more than Akagi's beam model says unless the
+//! substeps rise (`docs/PERFORMANCE.md`, "HSM stiffness against the wood's").
 //!
 //! **Rotation**: `R` is extracted by the iterative method of Müller, Bender, Chentanez &
 //! Macklin (2016), warm-started from the last step's R, `R ← rot(ω) R` (the unit
@@ -145,19 +153,20 @@ pub struct HsmParams {
     pub gravity: f32,
     /// The tree as generated is its shape *under its own weight*: a support equal and
     /// opposite to gravity holds every particle, so still air keeps the rest shape exactly.
-    /// Default true: generators draw trees as they stand, and shape matching's stiffness
-    /// is capped at α = 1 per substep, which for tall, thin trees is less than wood's — bare
-    /// gravity would sag them (a stem of n segments sags roughly as n² h² g). A support
+    /// Default true: generators draw trees as they stand, and a particle's step toward its
+    /// goal is capped at ᾱ = 1 per substep, which for tall, thin trees is less than wood's —
+    /// bare gravity would sag them (a stem of n segments sags roughly as n² h² g). A support
     /// that turned with the wood (`−R g`) was tried and rejected: it is not conservative
     /// and pumps energy into spinning leaves. False applies bare gravity.
     pub prestressed: bool,
     /// Müller's linear blend β ∈ [0, 1]: 0 matches rotations only (rigid clusters);
     /// larger values let clusters shear and stretch. Default 0.
     pub beta: f32,
-    /// Most iterations of the rotation extraction per step (it stops earlier when it has
-    /// converged). Default 2: warm-started from the last substep, one iteration tracks the
-    /// motion and the second refines it; a cold start (a cluster rotated far in one step)
-    /// needs up to about 20.
+    /// Iterations of the rotation extraction per step (all of them run, so R is a
+    /// continuous function of the particles; see [`crate::cpu::hsm::extract_rotation`]).
+    /// Default 2: warm-started from the last substep, one iteration tracks the motion and
+    /// the second refines it; a cold start (a cluster rotated far in one step) needs up to
+    /// about 20.
     pub polar_iterations: u32,
     /// Run stages 3 and 4 as one pass per particle (`hsm_particles`) instead of two
     /// (`hsm_goals`, then `hsm_integrate` through the goal buffer). Default true: a
@@ -166,8 +175,10 @@ pub struct HsmParams {
     /// `docs/PERFORMANCE.md`). False runs Song's four stages as published and keeps
     /// [`HsmState::goal`] up to date (the fused pass leaves it as it was).
     pub fused: bool,
-    /// Substeps per `step` call. Default 4: 240 Hz at 60 frames/s keeps α below 1 for the
-    /// default stiffness, so the trunk's sag and sway do not depend on the frame rate.
+    /// Substeps per `step` call. Default 4: 240 Hz at 60 frames/s, where the clusters of
+    /// long, slender trees (aspen, poplar, fir) have weights `k h²` below 1, so their sag
+    /// and sway do not depend on the frame rate. Trees of short, thick segments are stiffer
+    /// than 240 Hz can hold and bend less as substeps rise (module notes, "Stiffness").
     pub substeps: u32,
 }
 
@@ -310,7 +321,7 @@ pub struct RawHsmClusterInfo {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawHsmCluster {
-    /// Rest centre of mass c⁰ (xyz), m; w = stiffness k, 1/s².
+    /// Rest centre of mass c⁰ (xyz), m; w = stiffness (rate) k, 1/s².
     pub rest_cm: [f32; 4],
     /// Parent cluster (`u32::MAX` for the root).
     pub parent: u32,
@@ -320,7 +331,9 @@ pub struct RawHsmCluster {
     pub child_count: u32,
     /// Total mass of the cluster's particles, kg.
     pub mass: f32,
-    /// Columns of Aqq⁻¹ (xyz; zero where Aqq is singular), 1/(kg·m²).
+    /// Columns of Aqq⁻¹ (xyz; zero where Aqq is singular), 1/(kg·m²). The first column's w
+    /// is the rate bound k̂, 1/s²: the smallest k on the path from the root to this cluster
+    /// (see [`crate::cpu::hsm::MAX_WEIGHT`]); the other two are zero.
     pub aqq_inv: [[f32; 4]; 3],
 }
 
@@ -350,7 +363,7 @@ pub struct RawHsmMember {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawHsmClusterState {
-    /// Current centre of mass (xyz), m; w = α of this substep.
+    /// Current centre of mass (xyz), m; w = the cluster's weight `k h²` this substep.
     pub cm: [f32; 4],
     /// Rotation R as a unit quaternion (x, y, z, w), the warm start of the next step.
     pub rotation: [f32; 4],
@@ -742,6 +755,14 @@ impl HsmLayout {
                 mass: msum as f32,
                 aqq_inv: [inv.x_axis.extend(0.0).into(), inv.y_axis.extend(0.0).into(), inv.z_axis.extend(0.0).into()],
             });
+        }
+        // Each cluster's rate bound k̂: the smallest rate on its path to the root, itself
+        // included (clusters come after their parents, so one pass carries it down). Stage 1
+        // lets a cluster's weight pass 1 only up to k̂ h² (see `cpu::hsm::MAX_WEIGHT`).
+        for c in 0..n_clusters {
+            let p = parents[c];
+            let own = clusters[c].rest_cm[3];
+            clusters[c].aqq_inv[0][3] = if p == NONE { own } else { own.min(clusters[p as usize].aqq_inv[0][3]) };
         }
         // Each particle's (cluster, slot) pairs, in cluster order.
         let mut count = vec![0u32; n_particles + 1];

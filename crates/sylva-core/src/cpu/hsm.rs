@@ -123,6 +123,29 @@ pub fn rotation_step(r: Mat3, a: Mat3, eps: f32) -> Vec3 {
 /// blends the two up to twice this).
 pub const NEWTON_NEAR: f32 = 0.05;
 
+/// Largest weight a cluster brings to the mean of its particles' goals (stage 3).
+///
+/// A cluster's weight is `w = k h²`, its rate `k` (1/s²) times the substep squared; a
+/// particle shared by several clusters goes to the `w`-weighted mean of their goals, the
+/// point where their spring forces `m k_c (g_c − x)` balance, and moves `ᾱ = min(1, Σ w)`
+/// of the way there. That clamp keeps Müller's unconditional stability (a particle never
+/// passes its goal). The weights are **not** clamped at 1:
+/// * Clamped (Müller's per-cluster `α = min(1, k h²)`), every cluster stiffer than `1/h²`
+///   had an equal say, so a thick stem held the ring it shares with a twig or a leaf no
+///   better than the twig did, and a joint resisted only about `m r² / h²` (its ring's mass
+///   and lever). The stochastic bush, whose 3 cm stems are ~50× stiffer than that at
+///   240 Hz, lay down in gusty wind: segment ends 2.0 m from rest on a 2.3 m bush.
+/// * A weight passes 1 only up to `k̂ h²`, `k̂` the smallest rate on the cluster's path to
+///   the root ([`crate::animate::hsm::RawHsmCluster::aqq_inv`]'s first w). A cluster pulls
+///   the parent's rings it reaches into (`overlap`) at its own rate, and a thin twig's rate
+///   can be high only because it is light: unbounded, monopodial's laterals dragged its
+///   trunk (tips 3.0 m from rest in `gusty`, 0.24 m clamped). Below 1 nothing changes, so
+///   slender trees (every cluster under `1/h²`) move as before, bit for bit.
+///
+/// `MAX_WEIGHT` only keeps the sums finite: a ratio of 10⁶ between two clusters already
+/// leaves the softer one no say. WGSL: `MAX_WEIGHT` in `hsm.wgsl`.
+pub const MAX_WEIGHT: f32 = 1e6;
+
 /// One slot's terms of a cluster's sums from the particle's displacement `x` (w = mass) and
 /// the cluster's shift at the last substep `sp`: `[m u, m d q.x, m d q.y, m d q.z]` with
 /// `u = x − x⁰ − sp` and `d = u + q = x − c⁰ − sp` (so Apq stays exactly symmetric at
@@ -140,12 +163,12 @@ fn slot_terms(x: [f32; 4], sp: Vec3A, s: &RawHsmSlot) -> [Vec3A; 4] {
     [u * m, (d * q.x) * m, (d * q.y) * m, (d * q.z) * m]
 }
 
-/// Stage 1, per cluster: centre of mass, Apq, R, the goal transform, α and the wind at the
-/// centre. Sums run over the particles' displacements from rest `u = x − x⁰` (the state
-/// itself), so a cluster at rest has exactly zero shift and an exactly symmetric Apq
-/// (R = I): still air keeps the rest bit for bit. Bindings: 0 fields, 1 waves, 2 cluster
-/// info, 3 clusters, 4 slots, 5 displacements (w = mass), 6 step, 7 cluster state (read
-/// for R's warm start, written).
+/// Stage 1, per cluster: centre of mass, Apq, R, the goal transform, the weight `k h²` and
+/// the wind at the centre. Sums run over the particles' displacements from rest
+/// `u = x − x⁰` (the state itself), so a cluster at rest has exactly zero shift and an
+/// exactly symmetric Apq (R = I): still air keeps the rest bit for bit. Bindings: 0 fields,
+/// 1 waves, 2 cluster info, 3 clusters, 4 slots, 5 displacements (w = mass), 6 step,
+/// 7 cluster state (read for R's warm start, written).
 #[allow(clippy::too_many_arguments)]
 pub fn hsm_clusters(
     fields: &[RawField],
@@ -206,8 +229,10 @@ fn match_cluster(
             t = a * (step.beta / det.powf(1.0 / 3.0)) + r * (1.0 - step.beta);
         }
     }
-    let alpha = (cl.rest_cm[3] * step.dt * step.dt).min(1.0);
-    st.cm = [cm.x, cm.y, cm.z, alpha];
+    // The cluster's weight k h², past 1 only up to its path's k̂ h² (see `MAX_WEIGHT`).
+    let bound = (cl.aqq_inv[0][3] * step.dt * step.dt).max(1.0);
+    let weight = (cl.rest_cm[3] * step.dt * step.dt).min(bound).min(MAX_WEIGHT);
+    st.cm = [cm.x, cm.y, cm.z, weight];
     st.rotation = q.to_array();
     st.transform = [t.x_axis.extend(shift.x).into(), t.y_axis.extend(shift.y).into(), t.z_axis.extend(shift.z).into()];
     st.wind = [0.0; 4];
@@ -302,8 +327,9 @@ fn wind_chunk_at(
 }
 }
 
-/// A particle's goal as a displacement from rest (xyz) and ᾱ (w): the α-weighted mean over
-/// its clusters (see [`hsm_goals`]). WGSL: `hsm_particle_goal` in `hsm_gather.wgsl`.
+/// A particle's goal as a displacement from rest (xyz) and ᾱ (w): the mean over its
+/// clusters weighted by their `k h²` (see [`hsm_goals`], [`MAX_WEIGHT`]). WGSL:
+/// `hsm_particle_goal` in `hsm_gather.wgsl`.
 #[inline(always)]
 fn particle_goal(i: usize, member_offset: &[u32], member: &[RawHsmMember], state: &[RawHsmClusterState]) -> [f32; 4] {
     let lo = member_offset[i] as usize;
@@ -355,10 +381,10 @@ fn with_xyz(v: Vec3A, w: f32) -> [f32; 4] {
     v.extend(w).to_array()
 }
 
-/// Stage 3, per particle: the α-weighted mean of its clusters' goals `T_c q + c_c`, and
-/// `ᾱ = min(1, Σ α_c)`. Goals are kept as displacements from rest, `(T q − q) + (c − c⁰)`,
-/// so a cluster at rest gives exactly zero. Bindings: 0 member offsets, 1 members,
-/// 2 cluster state, 3 goals.
+/// Stage 3, per particle: the mean of its clusters' goals `T_c q + c_c` weighted by their
+/// `w_c = k_c h²`, and `ᾱ = min(1, Σ w_c)` (see [`MAX_WEIGHT`]). Goals are kept as
+/// displacements from rest, `(T q − q) + (c − c⁰)`, so a cluster at rest gives exactly
+/// zero. Bindings: 0 member offsets, 1 members, 2 cluster state, 3 goals.
 pub fn hsm_goals(member_offset: &[u32], member: &[RawHsmMember], state: &[RawHsmClusterState], goal: &mut [[f32; 4]]) {
     goal.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, g)| {
         *g = particle_goal(i, member_offset, member, state);

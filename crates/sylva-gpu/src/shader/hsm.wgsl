@@ -135,6 +135,11 @@ fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, eps: f32) -> vec3<f32> {
 // to twice this; NEWTON_NEAR on the CPU).
 const NEWTON_NEAR: f32 = 0.05;
 
+// Largest weight a cluster brings to the mean of its particles' goals: k h², past 1 only up
+// to the path's k̂ h² (aqq_inv[0].w); a particle's step min(1, Σ w) is clamped, the weights
+// are not (MAX_WEIGHT on the CPU).
+const MAX_WEIGHT: f32 = 1e6;
+
 // A cluster's goal for rest offset q, as a displacement from rest: (T q − q) + (c − c⁰).
 // Twin: goal_displacement in sylva_core::cpu::hsm.
 fn hsm_goal_displacement(st: HsmClusterState, q: vec3<f32>) -> vec3<f32> {

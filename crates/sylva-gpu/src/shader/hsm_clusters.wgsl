@@ -83,12 +83,14 @@ fn main(
             tr = a * (step.beta / pow(det, 1.0 / 3.0)) + r * (1.0 - step.beta);
         }
     }
-    let alpha = min(cl.rest_cm.w * step.dt * step.dt, 1.0);
+    // The cluster's weight k h², past 1 only up to its path's k̂ h² (see MAX_WEIGHT).
+    let bound = max(cl.aqq_inv[0].w * step.dt * step.dt, 1.0);
+    let weight = min(min(cl.rest_cm.w * step.dt * step.dt, bound), MAX_WEIGHT);
     var u = vec3<f32>(0.0);
     if (inf.kind != HSM_LEAF) {
         u = wind_at(cm, step.time);
     }
-    state[c].cm = vec4<f32>(cm, alpha);
+    state[c].cm = vec4<f32>(cm, weight);
     state[c].rotation = q;
     state[c].transform = array<vec4<f32>, 3>(
         vec4<f32>(tr[0], shift.x),
