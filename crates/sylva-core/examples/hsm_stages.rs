@@ -43,6 +43,48 @@ fn main() {
         return;
     }
     let step = h.step_params(1.0, 1.0 / 60.0);
+    if only == "runs" {
+        // The fused pass per particle (the WGSL twin's shape) against the CPU's run pass, from
+        // the same state; the results must agree bit for bit.
+        let runs = sylva_core::cpu::hsm_runs::HsmRuns::new(l);
+        hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut st.clusters);
+        let (mut a, mut b) = (st.clone(), st.clone());
+        let (mut ta, mut tb) = (0.0, 0.0);
+        for _ in 0..n {
+            let t = Instant::now();
+            hsm_particles(
+                &l.member_offset,
+                &l.member,
+                &a.clusters,
+                &l.owner,
+                step,
+                &mut a.displacement,
+                &mut a.velocity,
+            );
+            ta += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            sylva_core::cpu::hsm_runs::hsm_particles_runs(
+                l,
+                &runs,
+                &b.clusters,
+                step,
+                &mut b.displacement,
+                &mut b.velocity,
+            );
+            tb += t.elapsed().as_secs_f64();
+        }
+        let same = a
+            .displacement
+            .iter()
+            .flatten()
+            .zip(b.displacement.iter().flatten())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+            && a.velocity.iter().flatten().zip(b.velocity.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits());
+        let np = l.particle_count() as f64;
+        println!("{} runs for {} particles; identical bits: {same}", runs.len(), np);
+        println!("per particle {:.3} ms, runs {:.3} ms", ta / n as f64 * 1e3, tb / n as f64 * 1e3);
+        return;
+    }
     let (mut t1, mut t3, mut t4, mut tf) = (0.0, 0.0, 0.0, 0.0);
     let timed = |acc: &mut f64, run: &mut dyn FnMut()| {
         let t = Instant::now();

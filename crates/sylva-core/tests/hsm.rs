@@ -414,6 +414,65 @@ fn fused_particle_stages_match_the_four_stages_exactly() {
     assert_ne!(a.goal, b.goal);
 }
 
+/// The CPU's run pass (`hsm_particles_runs`: a ring's or a blade's particles eight to a
+/// register, their clusters read once) gives the bits of the per-particle pass that the WGSL
+/// twin mirrors, at every SIMD level: every preset with the default clusters (runs of two and
+/// four particles, partly filled registers) and Song's table sizes (rings of fourteen, blades
+/// of 42), from states a gusty wind has moved plus random noise on every free particle.
+#[test]
+fn the_run_pass_gives_the_per_particle_pass_bits() {
+    use sylva_core::cpu::hsm::hsm_particles;
+    use sylva_core::cpu::hsm_runs::{HsmRuns, hsm_particles_runs_at};
+    use sylva_core::simd::{Level, detected};
+    println!("best SIMD level here: {:?}", detected());
+    let wind = WindScene::resolve("gusty").unwrap();
+    let (f, w) = wind.pack();
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    let mut cases: Vec<(String, HsmParams, Option<usize>)> =
+        PRESETS.iter().map(|p| (p.name.to_string(), HsmParams::default(), Some(1_500))).collect();
+    cases.push(("quaking_aspen".into(), HsmParams::song_tables(), Some(300)));
+    for (name, params, max) in cases {
+        let t = tree(&name);
+        let layout = HsmLayout::new(&t, &params, max).unwrap();
+        let runs = HsmRuns::new(&layout);
+        assert!(runs.len() < layout.particle_count(), "{name}: no particles share a run");
+        let h = Hsm::from_layout(&t, params, layout);
+        let l = &h.layout;
+        let mut s = h.rest_state();
+        for _ in 0..10 {
+            h.step(&f, &w, &mut s, 1.0 / 60.0);
+        }
+        for (u, v) in s.displacement.iter_mut().zip(&mut s.velocity) {
+            if v[3] != FIXED {
+                for c in 0..3 {
+                    u[c] += rng.random_range(-0.05..0.05);
+                    v[c] += rng.random_range(-1.0..1.0);
+                }
+            }
+        }
+        let step = h.step_params(s.time + 1.0 / 240.0, 1.0 / 240.0);
+        hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &s.displacement, step, &mut s.clusters);
+        let mut reference = s.clone();
+        hsm_particles(
+            &l.member_offset,
+            &l.member,
+            &s.clusters,
+            &l.owner,
+            step,
+            &mut reference.displacement,
+            &mut reference.velocity,
+        );
+        assert_ne!(reference.displacement, s.displacement, "{name}: nothing moved");
+        let bits = |a: &[[f32; 4]]| a.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for level in [Level::Baseline, Level::Avx2] {
+            let mut b = s.clone();
+            hsm_particles_runs_at(level, l, &runs, &s.clusters, step, &mut b.displacement, &mut b.velocity);
+            assert!(bits(&b.displacement) == bits(&reference.displacement), "{name} {level:?}: displacements differ");
+            assert!(bits(&b.velocity) == bits(&reference.velocity), "{name} {level:?}: velocities differ");
+        }
+    }
+}
+
 /// The layout is Song's linearised tree: parents before children, children lists that
 /// point back, shared particles listed under every cluster that holds them, the root ring
 /// fixed, and a forest of copies that is the same layout repeated.

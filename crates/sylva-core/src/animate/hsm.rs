@@ -85,7 +85,8 @@
 //! (see the tests).
 
 use super::Pose;
-use crate::cpu::hsm::{hsm_clusters, hsm_goals, hsm_integrate, hsm_particles, hsm_pose};
+use crate::cpu::hsm::{hsm_clusters, hsm_goals, hsm_integrate, hsm_pose};
+use crate::cpu::hsm_runs::{HsmRuns, hsm_particles_runs};
 use crate::model::{NONE, Tree};
 use crate::wind::WindScene;
 use crate::wind::raw::{RawField, RawWave};
@@ -172,7 +173,9 @@ pub struct HsmParams {
     /// (`hsm_goals`, then `hsm_integrate` through the goal buffer). Default true: a
     /// particle's gathered goal is read by no other particle, so the fused pass gives the
     /// same numbers bit for bit while moving about a quarter fewer bytes per step (see
-    /// `docs/PERFORMANCE.md`). False runs Song's four stages as published and keeps
+    /// `docs/PERFORMANCE.md`). On the CPU the fused pass runs over runs of particles that
+    /// share their clusters, eight to an AVX2 register ([`crate::cpu::hsm_runs`]), with
+    /// the same bits again. False runs Song's four stages as published and keeps
     /// [`HsmState::goal`] up to date (the fused pass leaves it as it was).
     pub fused: bool,
     /// Substeps per `step` call. Default 4: 240 Hz at 60 frames/s, where the clusters of
@@ -866,6 +869,8 @@ pub struct Hsm {
     pub params: HsmParams,
     /// Song's linearised tree.
     pub layout: HsmLayout,
+    /// The layout's particles in runs of shared membership, for the CPU's fused pass.
+    runs: HsmRuns,
     rest_joints: Vec<[f32; 4]>,
 }
 
@@ -879,7 +884,8 @@ impl Hsm {
     /// Uses a prepared layout (truncated or a forest).
     pub fn from_layout(tree: &Tree, params: HsmParams, layout: HsmLayout) -> Self {
         let rest_joints = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
-        Self { params, layout, rest_joints }
+        let runs = HsmRuns::new(&layout);
+        Self { params, layout, runs, rest_joints }
     }
 
     /// The state at rest (without prestress, gravity has yet to sag it: see [`Self::settle`]).
@@ -921,15 +927,7 @@ impl Hsm {
         let step = self.step_params(state.time + h, h);
         hsm_clusters(fields, waves, &l.info, &l.clusters, &l.slots, &state.displacement, step, &mut state.clusters);
         if self.params.fused {
-            hsm_particles(
-                &l.member_offset,
-                &l.member,
-                &state.clusters,
-                &l.owner,
-                step,
-                &mut state.displacement,
-                &mut state.velocity,
-            );
+            hsm_particles_runs(l, &self.runs, &state.clusters, step, &mut state.displacement, &mut state.velocity);
         } else {
             hsm_goals(&l.member_offset, &l.member, &state.clusters, &mut state.goal);
             hsm_integrate(&l.owner, &state.clusters, &state.goal, step, &mut state.displacement, &mut state.velocity);

@@ -3,6 +3,7 @@
 
 pub mod akagi;
 pub mod hsm;
+pub mod hsm_runs;
 mod mesh_detail;
 mod mesh_leaves;
 mod mesh_tubes;
