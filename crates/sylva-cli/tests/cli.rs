@@ -412,6 +412,7 @@ fn bench_quick_writes_complete_tables() {
             assert!(particles > last, "rows grow");
             last = particles;
             assert!(r["bytes_per_step"].as_u64().unwrap() > particles);
+            assert!(r["cpu_bytes_per_step"].as_u64().unwrap() > particles);
             let cpu = &r["cpu"];
             assert!(cpu["median"].as_f64().unwrap() > 0.0);
             assert!(cpu["min"].as_f64().unwrap() <= cpu["median"].as_f64().unwrap());

@@ -3,7 +3,9 @@
 //! --example hsm_stages [C]`; `WIND=<preset or file>` picks the wind (default `gusty`),
 //! `N=<steps>` the number timed (default 50), `ONLY=clusters|fused` times that stage alone
 //! (its data then stays in cache between steps, which the full step does not allow), and
-//! `ONLY=step` whole steps, four-stage against fused.
+//! `ONLY=step` whole steps, four-stage against fused, `ONLY=runs` the fused pass per particle
+//! against the CPU's run pass (and checks that they agree bit for bit); `DEFAULT=1` uses the
+//! default clusters instead of Song's sizes.
 
 use std::time::Instant;
 use sylva_core::animate::hsm::*;
@@ -12,7 +14,8 @@ use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 fn main() {
     let tree = SpeciesSource::resolve("quaking_aspen").unwrap().generate(1, &Default::default(), None).unwrap();
-    let params = HsmParams::song_tables();
+    // `DEFAULT=1`: the default clusters (rings of four, two-particle blades) instead of Song's.
+    let params = if std::env::var_os("DEFAULT").is_some() { HsmParams::default() } else { HsmParams::song_tables() };
     let copies: usize = std::env::args().nth(1).map(|s| s.parse().unwrap()).unwrap_or(1);
     let one = HsmLayout::new(&tree, &params, Some(4975)).unwrap();
     let l = if copies > 1 { one.forest(copies, 30.0).unwrap() } else { one };

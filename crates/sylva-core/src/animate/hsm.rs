@@ -838,15 +838,19 @@ impl HsmLayout {
         self.rest.len()
     }
 
+    /// Stage 1's share of [`Self::bytes_per_step`]: info, clusters, cluster state (r/w);
+    /// per slot the record and the particle's displacement + mass.
+    pub fn stage1_bytes(&self) -> usize {
+        self.info.len() * (16 + 80 + 2 * 96) + self.slots.len() * (16 + 16)
+    }
+
     /// Bytes the stages must read and write per substep, each array counted once per
     /// stage that touches it (a lower bound on the traffic: gathered values are counted at
     /// their size, not their cache lines), for bandwidth figures. `fused`: stages 3 and 4
     /// in one pass.
     pub fn bytes_per_step(&self, fused: bool) -> usize {
-        let (c, p, s, m) = (self.info.len(), self.rest.len(), self.slots.len(), self.member.len());
-        // Stage 1: info, clusters, cluster state (r/w); per slot the record and the
-        // particle's displacement + mass.
-        let stage1 = c * (16 + 80 + 2 * 96) + s * (16 + 16);
+        let (p, m) = (self.rest.len(), self.member.len());
+        let stage1 = self.stage1_bytes();
         // Stage 3: offsets, goal written; per member: the record (q, cluster), the
         // cluster's transform and α.
         let members = m * (16 + 52);
@@ -902,6 +906,19 @@ impl Hsm {
             clusters: l.clusters.iter().map(RawHsmClusterState::rest).collect(),
             goal: vec![[0.0; 4]; l.rest.len()],
             time: 0.0,
+        }
+    }
+
+    /// Bytes a CPU substep moves, counted as [`HsmLayout::bytes_per_step`] counts them: the
+    /// same where the CPU runs the per-particle passes, fewer where the fused pass runs over
+    /// runs ([`HsmRuns::bytes_per_pass`]).
+    pub fn cpu_bytes_per_step(&self) -> usize {
+        let runs =
+            self.params.fused && cfg!(target_arch = "x86_64") && crate::simd::level() == crate::simd::Level::Avx2;
+        if runs {
+            self.layout.stage1_bytes() + self.runs.bytes_per_pass()
+        } else {
+            self.layout.bytes_per_step(self.params.fused)
         }
     }
 

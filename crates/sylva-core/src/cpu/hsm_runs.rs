@@ -122,6 +122,16 @@ impl HsmRuns {
         Self { runs, cluster, q, chunks }
     }
 
+    /// Bytes [`hsm_particles_runs`] reads and writes per pass, counted as
+    /// [`HsmLayout::bytes_per_step`] counts them: per run its record (24 B) and its owner's
+    /// wind (16 B); per run and cluster the cluster index (4 B), transform and weight (52 B);
+    /// the rest offsets as stored (12 B per membership, groups padded to eight); each
+    /// particle's displacement and velocity read and written (64 B).
+    pub fn bytes_per_pass(&self) -> usize {
+        let particles: usize = self.runs.iter().map(|r| r.len as usize).sum();
+        self.runs.len() * (24 + 16) + self.cluster.len() * (4 + 52) + self.q[0].len() * 12 + particles * 64
+    }
+
     /// Number of runs.
     pub fn len(&self) -> usize {
         self.runs.len()
