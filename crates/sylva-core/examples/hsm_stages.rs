@@ -29,6 +29,18 @@ fn main() {
         h.step(&f, &w, &mut st, 1.0 / 60.0);
     }
 
+    if only == "digest" {
+        // A digest of the state after `N` steps, to check that a change keeps the bits.
+        for _ in 0..n {
+            h.step(&f, &w, &mut st, 1.0 / 60.0);
+        }
+        let mut d = 0u64;
+        for x in st.displacement.iter().chain(&st.velocity).flatten() {
+            d = (d ^ x.to_bits() as u64).wrapping_mul(0x100_0000_01b3);
+        }
+        println!("state digest after {} steps: {d:016x}", n + 20);
+        return;
+    }
     if only == "step" {
         // Whole steps (`Hsm::step`), four-stage and fused, alternating.
         let four = Hsm::from_layout(&tree, HsmParams { fused: false, ..params }, l.clone());

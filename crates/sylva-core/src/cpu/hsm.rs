@@ -49,12 +49,22 @@ fn v3(a: [f32; 4]) -> Vec3 {
 /// runs started 1e-10 m/s apart ended 1e-5 × the tree's height apart after 1,000 steps,
 /// however small the start's difference (and a GPU, rounding differently, 5e-3).
 pub fn extract_rotation(a: Mat3, q: Quat, iterations: u32) -> Quat {
+    extract_rotations([a], [q], iterations)[0]
+}
+
+/// [`extract_rotation`] of `N` matrices, their iterations in lockstep: the same operations
+/// for each, so the same bits, but `N` independent chains of dependent operations (a
+/// division and a square root each iteration) for the CPU to overlap.
+#[inline(always)]
+pub fn extract_rotations<const N: usize>(a: [Mat3; N], q: [Quat; N], iterations: u32) -> [Quat; N] {
     let mut q = q;
-    let eps = 1e-6 * (a.x_axis.length() + a.y_axis.length() + a.z_axis.length()) + 1e-30;
+    let eps = a.map(|a| 1e-6 * (a.x_axis.length() + a.y_axis.length() + a.z_axis.length()) + 1e-30);
     for _ in 0..iterations {
-        let r = Mat3::from_quat(q);
-        let half = rotation_step(r, a, eps) * 0.5;
-        q = (Quat::from_xyzw(half.x, half.y, half.z, 1.0) * q).normalize();
+        for k in 0..N {
+            let r = Mat3::from_quat(q[k]);
+            let half = rotation_step(r, a[k], eps[k]) * 0.5;
+            q[k] = (Quat::from_xyzw(half.x, half.y, half.z, 1.0) * q[k]).normalize();
+        }
     }
     q
 }
@@ -188,8 +198,25 @@ pub fn hsm_clusters(
         let base = k * CHUNK;
         // A cluster's quarter lanes (see `cluster_sums`).
         let mut quarter = [[Vec3A::ZERO; 4]; LANES / 4];
-        for (i, st) in chunk.iter_mut().enumerate() {
-            match_cluster(&info[base + i], &clusters[base + i], slots, displacement, &step, &mut quarter, st);
+        // Four clusters at a time, their rotations extracted in lockstep.
+        for (g, group) in chunk.chunks_mut(ROTATIONS).enumerate() {
+            let at = base + g * ROTATIONS;
+            let mut sums = [(Mat3::ZERO, Vec3::ZERO); ROTATIONS];
+            for (i, st) in group.iter().enumerate() {
+                sums[i] = cluster_apq(&info[at + i], &clusters[at + i], slots, displacement, &mut quarter, st);
+            }
+            let q: [Quat; ROTATIONS] = if group.len() == ROTATIONS {
+                let start = std::array::from_fn(|i| Quat::from_array(group[i].rotation));
+                extract_rotations(sums.map(|s| s.0), start, step.polar_iterations)
+            } else {
+                std::array::from_fn(|i| match group.get(i) {
+                    Some(st) => extract_rotation(sums[i].0, Quat::from_array(st.rotation), step.polar_iterations),
+                    None => Quat::IDENTITY,
+                })
+            };
+            for (i, st) in group.iter_mut().enumerate() {
+                finish_cluster(&clusters[at + i], sums[i], q[i], &step, st);
+            }
         }
         if !fields.is_empty() {
             wind_chunk_at(level, fields, waves, &info[base..base + chunk.len()], step.time, chunk);
@@ -197,28 +224,41 @@ pub fn hsm_clusters(
     });
 }
 
-/// Stage 1 for one cluster (one workgroup of `hsm_clusters.wgsl`), the wind aside.
+/// Clusters whose rotations stage 1 extracts together (see [`extract_rotations`]).
+const ROTATIONS: usize = 4;
+
+/// Stage 1 for one cluster (one workgroup of `hsm_clusters.wgsl`) up to R: its Apq and the
+/// shift of its centre from rest.
 #[inline(always)]
-fn match_cluster(
+fn cluster_apq(
     inf: &RawHsmClusterInfo,
     cl: &RawHsmCluster,
     slots: &[RawHsmSlot],
     displacement: &[[f32; 4]],
-    step: &RawHsmStep,
     quarter: &mut [[Vec3A; 4]; LANES / 4],
-    st: &mut RawHsmClusterState,
-) {
-    let c0 = v3(cl.rest_cm);
+    st: &RawHsmClusterState,
+) -> (Mat3, Vec3) {
     let run = &slots[inf.slot_offset as usize..(inf.slot_offset + inf.slot_count) as usize];
     // Sums about the last substep's shift (see `slot_terms`).
     let t = &st.transform;
     let sp = Vec3A::new(t[0][3], t[1][3], t[2][3]);
     let [sm, a0, a1, a2] = cluster_sums(run, displacement, sp, quarter).map(Vec3::from);
     let shift = Vec3::from(sp) + sm / cl.mass;
-    let cm = c0 + shift;
     // Σ m q = 0, so Σ m (x − c⁰ − sp) qᵀ is Apq = Σ m (x − c) qᵀ.
-    let apq = Mat3::from_cols(a0, a1, a2);
-    let q = extract_rotation(apq, Quat::from_array(st.rotation), step.polar_iterations);
+    (Mat3::from_cols(a0, a1, a2), shift)
+}
+
+/// Stage 1 for one cluster after R (`q`): the goal transform, the weight `k h²` and the
+/// state, the wind aside.
+#[inline(always)]
+fn finish_cluster(
+    cl: &RawHsmCluster,
+    (apq, shift): (Mat3, Vec3),
+    q: Quat,
+    step: &RawHsmStep,
+    st: &mut RawHsmClusterState,
+) {
+    let cm = v3(cl.rest_cm) + shift;
     let r = Mat3::from_quat(q);
     let mut t = r;
     if step.beta > 0.0 {
