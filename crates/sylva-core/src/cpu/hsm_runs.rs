@@ -24,7 +24,7 @@ use rayon::prelude::*;
 const WIDTH: usize = 8;
 
 /// The lane of the `i`-th particle of a group of eight once its records are transposed
-/// (see `avx2::transpose_in`): even particles in the low half, odd in the high.
+/// (see `avx2::transpose`): even particles in the low half, odd in the high.
 const LANE_OF: [usize; WIDTH] = [0, 4, 1, 5, 2, 6, 3, 7];
 
 /// Particles grouped into runs of shared membership (see the module notes). Built once per
@@ -202,10 +202,12 @@ mod avx2 {
     use crate::animate::hsm::{RawHsmClusterState, RawHsmStep};
     use std::arch::x86_64::*;
 
-    /// Eight records' (x, y, z, w) from four registers of two records each, as four
-    /// registers of one component each, particles in the order of [`LANE_OF`].
+    /// Eight records' (x, y, z, w) from four registers of two records each (register `k`
+    /// holding records `2k` and `2k + 1`) as four registers of one component each, particles
+    /// in the order of [`super::LANE_OF`]; and back: the 4×4 transpose within each 128-bit
+    /// half is its own inverse.
     #[inline(always)]
-    fn transpose_in(r: [__m256; 4]) -> [__m256; 4] {
+    fn transpose(r: [__m256; 4]) -> [__m256; 4] {
         // SAFETY (all intrinsics here): the caller runs with AVX2.
         unsafe {
             let t0 = _mm256_unpacklo_ps(r[0], r[1]);
@@ -217,23 +219,6 @@ mod avx2 {
                 _mm256_shuffle_ps::<0xEE>(t0, t2),
                 _mm256_shuffle_ps::<0x44>(t1, t3),
                 _mm256_shuffle_ps::<0xEE>(t1, t3),
-            ]
-        }
-    }
-
-    /// The inverse of [`transpose_in`].
-    #[inline(always)]
-    fn transpose_out(c: [__m256; 4]) -> [__m256; 4] {
-        unsafe {
-            let t0 = _mm256_unpacklo_ps(c[0], c[1]);
-            let t1 = _mm256_unpacklo_ps(c[2], c[3]);
-            let t2 = _mm256_unpackhi_ps(c[0], c[1]);
-            let t3 = _mm256_unpackhi_ps(c[2], c[3]);
-            [
-                _mm256_shuffle_ps::<0x44>(t0, t1),
-                _mm256_shuffle_ps::<0xEE>(t0, t1),
-                _mm256_shuffle_ps::<0x44>(t2, t3),
-                _mm256_shuffle_ps::<0xEE>(t2, t3),
             ]
         }
     }
@@ -259,14 +244,14 @@ mod avx2 {
             // Masked-off records are not read (`wrapping_add`: they may lie past the slice).
             std::array::from_fn(|k| unsafe { _mm256_maskload_ps(p.wrapping_add(8 * k), m[k]) })
         };
-        transpose_in(r)
+        transpose(r)
     }
 
     /// Components back as eight (or the first `n`) records at `dst`.
     #[inline(always)]
     unsafe fn store(dst: *mut [f32; 4], n: usize, c: [__m256; 4]) {
         let p = dst as *mut f32;
-        let r = transpose_out(c);
+        let r = transpose(c);
         if n == WIDTH {
             for (k, r) in r.into_iter().enumerate() {
                 unsafe { _mm256_storeu_ps(p.add(8 * k), r) };
