@@ -86,7 +86,7 @@
 
 use super::Pose;
 use crate::cpu::hsm::{hsm_clusters, hsm_goals, hsm_integrate, hsm_pose};
-use crate::cpu::hsm_runs::{HsmRuns, hsm_particles_runs};
+use crate::cpu::hsm_runs::{HsmRuns, hsm_particles_runs, runs_at};
 use crate::model::{NONE, Tree};
 use crate::wind::WindScene;
 use crate::wind::raw::{RawField, RawWave};
@@ -913,9 +913,7 @@ impl Hsm {
     /// same where the CPU runs the per-particle passes, fewer where the fused pass runs over
     /// runs ([`HsmRuns::bytes_per_pass`]).
     pub fn cpu_bytes_per_step(&self) -> usize {
-        let runs =
-            self.params.fused && cfg!(target_arch = "x86_64") && crate::simd::level() == crate::simd::Level::Avx2;
-        if runs {
+        if self.params.fused && runs_at(crate::simd::level()) {
             self.layout.stage1_bytes() + self.runs.bytes_per_pass()
         } else {
             self.layout.bytes_per_step(self.params.fused)

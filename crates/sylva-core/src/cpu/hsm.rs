@@ -205,15 +205,10 @@ pub fn hsm_clusters(
             for (i, st) in group.iter().enumerate() {
                 sums[i] = cluster_apq(&info[at + i], &clusters[at + i], slots, displacement, &mut quarter, st);
             }
-            let q: [Quat; ROTATIONS] = if group.len() == ROTATIONS {
-                let start = std::array::from_fn(|i| Quat::from_array(group[i].rotation));
-                extract_rotations(sums.map(|s| s.0), start, step.polar_iterations)
-            } else {
-                std::array::from_fn(|i| match group.get(i) {
-                    Some(st) => extract_rotation(sums[i].0, Quat::from_array(st.rotation), step.polar_iterations),
-                    None => Quat::IDENTITY,
-                })
-            };
+            // A last, short group is padded with zero matrices (their rotations are unused).
+            let start =
+                std::array::from_fn(|i| group.get(i).map_or(Quat::IDENTITY, |st| Quat::from_array(st.rotation)));
+            let q = extract_rotations(sums.map(|s| s.0), start, step.polar_iterations);
             for (i, st) in group.iter_mut().enumerate() {
                 finish_cluster(&clusters[at + i], sums[i], q[i], &step, st);
             }

@@ -143,6 +143,12 @@ impl HsmRuns {
     }
 }
 
+/// Whether [`hsm_particles_runs_at`] runs the runs at `level` (AVX2 on this CPU) rather than
+/// [`super::hsm::hsm_particles`].
+pub fn runs_at(level: Level) -> bool {
+    cfg!(target_arch = "x86_64") && level.min(crate::simd::detected()) == Level::Avx2
+}
+
 /// [`super::hsm::hsm_particles`] over `runs` (made from `layout`) at the CPU's best
 /// [`Level`]: the same bits.
 pub fn hsm_particles_runs(
@@ -168,7 +174,7 @@ pub fn hsm_particles_runs_at(
     velocity: &mut [[f32; 4]],
 ) {
     #[cfg(target_arch = "x86_64")]
-    if level.min(crate::simd::detected()) == Level::Avx2 {
+    if runs_at(level) {
         // Each chunk's particles as its own slices.
         let mut parts = Vec::with_capacity(runs.chunks.len());
         let (mut d, mut v) = (displacement, velocity);
