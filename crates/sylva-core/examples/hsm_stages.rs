@@ -4,8 +4,10 @@
 //! `N=<steps>` the number timed (default 50), `ONLY=clusters|fused` times that stage alone
 //! (its data then stays in cache between steps, which the full step does not allow), and
 //! `ONLY=step` whole steps, four-stage against fused, `ONLY=runs` the fused pass per particle
-//! against the CPU's run pass (and checks that they agree bit for bit); `DEFAULT=1` uses the
-//! default clusters instead of Song's sizes.
+//! against the CPU's run pass (and checks that they agree bit for bit), `ONLY=groups` stage 1
+//! per slot against the CPU's groups of slots (checking the bits too), `ONLY=digest` prints a
+//! digest of the state after `N` more steps; `DEFAULT=1` uses the default clusters instead of
+//! Song's sizes.
 
 use std::time::Instant;
 use sylva_core::animate::hsm::*;
@@ -58,6 +60,26 @@ fn main() {
         return;
     }
     let step = h.step_params(1.0, 1.0 / 60.0);
+    if only == "groups" {
+        // Stage 1 in the WGSL twin's shape against the CPU's groups of slots, from the same
+        // state; the results must agree bit for bit.
+        let groups = sylva_core::cpu::hsm_slot_groups::HsmSlotGroups::new(l);
+        let (mut a, mut b) = (st.clusters.clone(), st.clusters.clone());
+        let (mut ta, mut tb) = (0.0, 0.0);
+        let mut same = true;
+        for _ in 0..n {
+            let t = Instant::now();
+            hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut a);
+            ta += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            sylva_core::cpu::hsm_slot_groups::hsm_clusters_groups(&f, &w, l, &groups, &st.displacement, step, &mut b);
+            tb += t.elapsed().as_secs_f64();
+            same &= bytemuck::cast_slice::<_, u32>(&a) == bytemuck::cast_slice::<_, u32>(&b);
+        }
+        println!("{} groups for {} slots; identical bits: {same}", groups.len(), l.slots.len());
+        println!("per slot {:.3} ms, groups {:.3} ms", ta / n as f64 * 1e3, tb / n as f64 * 1e3);
+        return;
+    }
     if only == "runs" {
         // The fused pass per particle (the WGSL twin's shape) against the CPU's run pass, from
         // the same state; the results must agree bit for bit.

@@ -473,6 +473,67 @@ fn the_run_pass_gives_the_per_particle_pass_bits() {
     }
 }
 
+/// The CPU's stage 1 over groups of slots (`hsm_clusters_groups`: eight slots to a register,
+/// lane blocks combined as the workgroup's lanes are) gives the bits of the per-slot stage 1
+/// that the WGSL twin mirrors, at every SIMD level: every preset with the default clusters
+/// (a few slots each, short groups), Song's table sizes (about 64) and clusters of over 64
+/// slots (lanes that take more than one), from states a gusty wind has moved plus random
+/// noise on every free particle.
+#[test]
+fn the_slot_groups_give_the_per_slot_stage_1_bits() {
+    use sylva_core::cpu::hsm_slot_groups::{HsmSlotGroups, hsm_clusters_groups_at};
+    use sylva_core::simd::{Level, detected};
+    println!("best SIMD level here: {:?}", detected());
+    let wind = WindScene::resolve("gusty").unwrap();
+    let (f, w) = wind.pack();
+    let mut rng = ChaCha8Rng::seed_from_u64(29);
+    let mut cases: Vec<(String, HsmParams, Option<usize>)> =
+        PRESETS.iter().map(|p| (p.name.to_string(), HsmParams::default(), Some(1_500))).collect();
+    cases.push(("quaking_aspen".into(), HsmParams::song_tables(), Some(300)));
+    let wide = HsmParams { rings: 6, ring_size: 20, leaf_particles: 21, ..HsmParams::default() };
+    cases.push(("sympodial".into(), wide, Some(200)));
+    let sixteen = HsmParams { rings: 2, ring_size: 8, leaf_particles: 16, ..HsmParams::default() };
+    cases.push(("sympodial".into(), sixteen, Some(200)));
+    let mut counts = std::collections::BTreeSet::new();
+    for (name, params, max) in cases {
+        let t = tree(&name);
+        let layout = HsmLayout::new(&t, &params, max).unwrap();
+        let groups = HsmSlotGroups::new(&layout);
+        counts.extend(layout.info.iter().map(|i| i.slot_count));
+        let h = Hsm::from_layout(&t, params, layout);
+        let l = &h.layout;
+        let mut s = h.rest_state();
+        for _ in 0..10 {
+            h.step(&f, &w, &mut s, 1.0 / 60.0);
+        }
+        for (u, v) in s.displacement.iter_mut().zip(&s.velocity) {
+            if v[3] != FIXED {
+                for c in 0..3 {
+                    u[c] += rng.random_range(-0.05..0.05);
+                }
+            }
+        }
+        let step = h.step_params(s.time + 1.0 / 240.0, 1.0 / 240.0);
+        let mut reference = s.clusters.clone();
+        hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &s.displacement, step, &mut reference);
+        assert_ne!(reference, s.clusters, "{name}: nothing moved");
+        let bits = |a: &[RawHsmClusterState]| bytemuck::cast_slice::<_, u32>(a).to_vec();
+        for level in [Level::Baseline, Level::Avx2] {
+            let mut b = s.clusters.clone();
+            hsm_clusters_groups_at(level, &f, &w, l, &groups, &s.displacement, step, &mut b);
+            assert!(bits(&b) == bits(&reference), "{name} {level:?}: cluster states differ");
+        }
+    }
+    // The cases reach every way a cluster's slots fill the lanes, in the groups (16 slots and
+    // up) and on SSE (fewer).
+    println!("slot counts: {counts:?}");
+    let any = |p: &dyn Fn(u32) -> bool| counts.iter().any(|&c| p(c));
+    assert!(any(&|c| c < 8) && any(&|c| (8..16).contains(&c)), "no small clusters");
+    assert!(any(&|c| c == 16) && any(&|c| (17..=32).contains(&c)), "no clusters of 16 to 32 slots");
+    assert!(any(&|c| (33..=64).contains(&c)) && any(&|c| c > 64), "no clusters of over 32 slots");
+    assert!(any(&|c| c > 16 && c % 8 != 0), "no short last group");
+}
+
 /// The layout is Song's linearised tree: parents before children, children lists that
 /// point back, shared particles listed under every cluster that holds them, the root ring
 /// fixed, and a forest of copies that is the same layout repeated.

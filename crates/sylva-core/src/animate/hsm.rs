@@ -85,8 +85,9 @@
 //! (see the tests).
 
 use super::Pose;
-use crate::cpu::hsm::{hsm_clusters, hsm_goals, hsm_integrate, hsm_pose};
-use crate::cpu::hsm_runs::{HsmRuns, hsm_particles_runs, runs_at};
+use crate::cpu::hsm::{hsm_goals, hsm_integrate, hsm_pose};
+use crate::cpu::hsm_runs::{HsmRuns, avx2_at, hsm_particles_runs};
+use crate::cpu::hsm_slot_groups::{HsmSlotGroups, hsm_clusters_groups};
 use crate::model::{NONE, Tree};
 use crate::wind::WindScene;
 use crate::wind::raw::{RawField, RawWave};
@@ -875,6 +876,8 @@ pub struct Hsm {
     pub layout: HsmLayout,
     /// The layout's particles in runs of shared membership, for the CPU's fused pass.
     runs: HsmRuns,
+    /// The layout's slots in groups of eight, for the CPU's stage 1.
+    groups: HsmSlotGroups,
     rest_joints: Vec<[f32; 4]>,
 }
 
@@ -889,7 +892,8 @@ impl Hsm {
     pub fn from_layout(tree: &Tree, params: HsmParams, layout: HsmLayout) -> Self {
         let rest_joints = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
         let runs = HsmRuns::new(&layout);
-        Self { params, layout, runs, rest_joints }
+        let groups = HsmSlotGroups::new(&layout);
+        Self { params, layout, runs, groups, rest_joints }
     }
 
     /// The state at rest (without prestress, gravity has yet to sag it: see [`Self::settle`]).
@@ -910,14 +914,17 @@ impl Hsm {
     }
 
     /// Bytes a CPU substep moves, counted as [`HsmLayout::bytes_per_step`] counts them: the
-    /// same where the CPU runs the per-particle passes, fewer where the fused pass runs over
-    /// runs ([`HsmRuns::bytes_per_pass`]).
+    /// same where the CPU runs the WGSL's shapes, fewer where it runs its fast forms (stage 1
+    /// over groups of slots, [`HsmSlotGroups::bytes_per_pass`], and the fused pass over runs,
+    /// [`HsmRuns::bytes_per_pass`]).
     pub fn cpu_bytes_per_step(&self) -> usize {
-        if self.params.fused && runs_at(crate::simd::level()) {
-            self.layout.stage1_bytes() + self.runs.bytes_per_pass()
-        } else {
-            self.layout.bytes_per_step(self.params.fused)
+        let l = &self.layout;
+        if !avx2_at(crate::simd::level()) {
+            return l.bytes_per_step(self.params.fused);
         }
+        let particles =
+            if self.params.fused { self.runs.bytes_per_pass() } else { l.bytes_per_step(false) - l.stage1_bytes() };
+        self.groups.bytes_per_pass() + particles
     }
 
     /// The per-substep values the kernels read.
@@ -940,7 +947,7 @@ impl Hsm {
     pub fn substep(&self, fields: &[RawField], waves: &[RawWave], state: &mut HsmState, h: f32) {
         let l = &self.layout;
         let step = self.step_params(state.time + h, h);
-        hsm_clusters(fields, waves, &l.info, &l.clusters, &l.slots, &state.displacement, step, &mut state.clusters);
+        hsm_clusters_groups(fields, waves, l, &self.groups, &state.displacement, step, &mut state.clusters);
         if self.params.fused {
             hsm_particles_runs(l, &self.runs, &state.clusters, step, &mut state.displacement, &mut state.velocity);
         } else {

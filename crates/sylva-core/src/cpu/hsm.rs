@@ -190,27 +190,54 @@ pub fn hsm_clusters(
     step: RawHsmStep,
     state: &mut [RawHsmClusterState],
 ) {
+    hsm_clusters_with(fields, waves, info, clusters, step, state, |c, sp, quarter| {
+        let inf = &info[c];
+        let run = &slots[inf.slot_offset as usize..(inf.slot_offset + inf.slot_count) as usize];
+        cluster_sums(run, displacement, sp, quarter)
+    });
+}
+
+/// Scratch of one chunk of stage 1: a cluster's quarter lanes (see [`cluster_sums`]).
+pub(crate) type Quarter = [[Vec3A; 4]; LANES / 4];
+
+/// [`hsm_clusters`] with each cluster's sums `[Σ m u, Apq columns]` about the shift `sp`
+/// from `sums(cluster, sp, scratch)`, which must add as [`cluster_sums`] does (the CPU's fast
+/// form, [`super::hsm_slot_groups`], gives the same bits).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn hsm_clusters_with<S>(
+    fields: &[RawField],
+    waves: &[RawWave],
+    info: &[RawHsmClusterInfo],
+    clusters: &[RawHsmCluster],
+    step: RawHsmStep,
+    state: &mut [RawHsmClusterState],
+    sums: S,
+) where
+    S: Fn(usize, Vec3A, &mut Quarter) -> [Vec3A; 4] + Sync,
+{
     // One parallel pass: each chunk of clusters gets its shape matching, then the wind at
     // the new centres (fixed chunks, so the wind's lane groups do not depend on the threads).
     const CHUNK: usize = 256;
     let level = crate::simd::level();
     state.par_chunks_mut(CHUNK).enumerate().for_each(|(k, chunk)| {
         let base = k * CHUNK;
-        // A cluster's quarter lanes (see `cluster_sums`).
         let mut quarter = [[Vec3A::ZERO; 4]; LANES / 4];
         // Four clusters at a time, their rotations extracted in lockstep.
         for (g, group) in chunk.chunks_mut(ROTATIONS).enumerate() {
             let at = base + g * ROTATIONS;
-            let mut sums = [(Mat3::ZERO, Vec3::ZERO); ROTATIONS];
+            let mut apq = [(Mat3::ZERO, Vec3::ZERO); ROTATIONS];
             for (i, st) in group.iter().enumerate() {
-                sums[i] = cluster_apq(&info[at + i], &clusters[at + i], slots, displacement, &mut quarter, st);
+                // Sums about the last substep's shift (see `slot_terms`).
+                let t = &st.transform;
+                let sp = Vec3A::new(t[0][3], t[1][3], t[2][3]);
+                apq[i] = cluster_apq(&clusters[at + i], sums(at + i, sp, &mut quarter), sp);
             }
             // A last, short group is padded with zero matrices (their rotations are unused).
             let start =
                 std::array::from_fn(|i| group.get(i).map_or(Quat::IDENTITY, |st| Quat::from_array(st.rotation)));
-            let q = extract_rotations(sums.map(|s| s.0), start, step.polar_iterations);
+            let q = extract_rotations(apq.map(|s| s.0), start, step.polar_iterations);
             for (i, st) in group.iter_mut().enumerate() {
-                finish_cluster(&clusters[at + i], sums[i], q[i], &step, st);
+                finish_cluster(&clusters[at + i], apq[i], q[i], &step, st);
             }
         }
         if !fields.is_empty() {
@@ -223,21 +250,10 @@ pub fn hsm_clusters(
 const ROTATIONS: usize = 4;
 
 /// Stage 1 for one cluster (one workgroup of `hsm_clusters.wgsl`) up to R: its Apq and the
-/// shift of its centre from rest.
+/// shift of its centre from rest, from its sums about the last shift `sp`.
 #[inline(always)]
-fn cluster_apq(
-    inf: &RawHsmClusterInfo,
-    cl: &RawHsmCluster,
-    slots: &[RawHsmSlot],
-    displacement: &[[f32; 4]],
-    quarter: &mut [[Vec3A; 4]; LANES / 4],
-    st: &RawHsmClusterState,
-) -> (Mat3, Vec3) {
-    let run = &slots[inf.slot_offset as usize..(inf.slot_offset + inf.slot_count) as usize];
-    // Sums about the last substep's shift (see `slot_terms`).
-    let t = &st.transform;
-    let sp = Vec3A::new(t[0][3], t[1][3], t[2][3]);
-    let [sm, a0, a1, a2] = cluster_sums(run, displacement, sp, quarter).map(Vec3::from);
+fn cluster_apq(cl: &RawHsmCluster, sums: [Vec3A; 4], sp: Vec3A) -> (Mat3, Vec3) {
+    let [sm, a0, a1, a2] = sums.map(Vec3::from);
     let shift = Vec3::from(sp) + sm / cl.mass;
     // Σ m q = 0, so Σ m (x − c⁰ − sp) qᵀ is Apq = Σ m (x − c) qᵀ.
     (Mat3::from_cols(a0, a1, a2), shift)
@@ -309,11 +325,11 @@ fn add4(a: [Vec3A; 4], b: [Vec3A; 4]) -> [Vec3A; 4] {
 /// the quarter's lanes go through memory: the same additions in the same order, so the same
 /// bits, without writing every slot's terms out and reading them back.
 #[inline(always)]
-fn cluster_sums(
+pub(crate) fn cluster_sums(
     run: &[RawHsmSlot],
     displacement: &[[f32; 4]],
     sp: Vec3A,
-    quarter: &mut [[Vec3A; 4]; LANES / 4],
+    quarter: &mut Quarter,
 ) -> [Vec3A; 4] {
     let width = run.len().clamp(1, LANES).next_power_of_two();
     let lane = |t: usize| lane_sums(run, displacement, sp, t);

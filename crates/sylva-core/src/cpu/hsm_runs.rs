@@ -21,11 +21,11 @@ use crate::simd::Level;
 use rayon::prelude::*;
 
 /// Particles per register.
-const WIDTH: usize = 8;
+pub(crate) const WIDTH: usize = 8;
 
 /// The lane of the `i`-th particle of a group of eight once its records are transposed
 /// (see `avx2::transpose`): even particles in the low half, odd in the high.
-const LANE_OF: [usize; WIDTH] = [0, 4, 1, 5, 2, 6, 3, 7];
+pub(crate) const LANE_OF: [usize; WIDTH] = [0, 4, 1, 5, 2, 6, 3, 7];
 
 /// Particles grouped into runs of shared membership (see the module notes). Built once per
 /// layout; the layout's own arrays stay what the GPU and the four-stage path read.
@@ -143,9 +143,11 @@ impl HsmRuns {
     }
 }
 
-/// Whether [`hsm_particles_runs_at`] runs the runs at `level` (AVX2 on this CPU) rather than
-/// [`super::hsm::hsm_particles`].
-pub fn runs_at(level: Level) -> bool {
+/// Whether the CPU's fast forms run at `level` (AVX2 on this CPU): [`hsm_particles_runs_at`]
+/// the runs rather than [`super::hsm::hsm_particles`], and
+/// [`super::hsm_slot_groups::hsm_clusters_groups_at`] the groups rather than
+/// [`super::hsm::hsm_clusters`].
+pub fn avx2_at(level: Level) -> bool {
     cfg!(target_arch = "x86_64") && level.min(crate::simd::detected()) == Level::Avx2
 }
 
@@ -174,7 +176,7 @@ pub fn hsm_particles_runs_at(
     velocity: &mut [[f32; 4]],
 ) {
     #[cfg(target_arch = "x86_64")]
-    if runs_at(level) {
+    if avx2_at(level) {
         // Each chunk's particles as its own slices.
         let mut parts = Vec::with_capacity(runs.chunks.len());
         let (mut d, mut v) = (displacement, velocity);
@@ -203,7 +205,7 @@ pub fn hsm_particles_runs_at(
 
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
-mod avx2 {
+pub(crate) mod avx2 {
     use super::{HsmRuns, Run, WIDTH};
     use crate::animate::hsm::{RawHsmClusterState, RawHsmStep};
     use std::arch::x86_64::*;
@@ -213,7 +215,7 @@ mod avx2 {
     /// in the order of [`super::LANE_OF`]; and back: the 4×4 transpose within each 128-bit
     /// half is its own inverse.
     #[inline(always)]
-    fn transpose(r: [__m256; 4]) -> [__m256; 4] {
+    pub(crate) fn transpose(r: [__m256; 4]) -> [__m256; 4] {
         // SAFETY (all intrinsics here): the caller runs with AVX2.
         unsafe {
             let t0 = _mm256_unpacklo_ps(r[0], r[1]);

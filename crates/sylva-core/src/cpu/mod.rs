@@ -4,6 +4,7 @@
 pub mod akagi;
 pub mod hsm;
 pub mod hsm_runs;
+pub mod hsm_slot_groups;
 mod mesh_detail;
 mod mesh_leaves;
 mod mesh_tubes;
