@@ -414,6 +414,39 @@ fn fused_particle_stages_match_the_four_stages_exactly() {
     assert_ne!(a.goal, b.goal);
 }
 
+/// Every preset with the default clusters and Song's table sizes, then `extra`: each moved
+/// by ten frames of gusty wind, then every free particle's displacement jittered by up to
+/// 5 cm and its velocity by up to 1 m/s (seeded): states on which the CPU's fast forms must
+/// give the bits of the WGSL twins' shapes.
+fn jittered_cases(extra: Vec<(String, HsmParams, Option<usize>)>, seed: u64) -> Vec<(String, Hsm, HsmState)> {
+    let (f, w) = WindScene::resolve("gusty").unwrap().pack();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut cases: Vec<(String, HsmParams, Option<usize>)> =
+        PRESETS.iter().map(|p| (p.name.to_string(), HsmParams::default(), Some(1_500))).collect();
+    cases.push(("quaking_aspen".into(), HsmParams::song_tables(), Some(300)));
+    cases.extend(extra);
+    cases
+        .into_iter()
+        .map(|(name, params, max)| {
+            let t = tree(&name);
+            let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, max).unwrap());
+            let mut s = h.rest_state();
+            for _ in 0..10 {
+                h.step(&f, &w, &mut s, 1.0 / 60.0);
+            }
+            for (u, v) in s.displacement.iter_mut().zip(&mut s.velocity) {
+                if v[3] != FIXED {
+                    for c in 0..3 {
+                        u[c] += rng.random_range(-0.05..0.05);
+                        v[c] += rng.random_range(-1.0..1.0);
+                    }
+                }
+            }
+            (name, h, s)
+        })
+        .collect()
+}
+
 /// The CPU's run pass (`hsm_particles_runs`: a ring's or a blade's particles eight to a
 /// register, their clusters read once) gives the bits of the per-particle pass that the WGSL
 /// twin mirrors, at every SIMD level: every preset with the default clusters (runs of two and
@@ -425,31 +458,11 @@ fn the_run_pass_gives_the_per_particle_pass_bits() {
     use sylva_core::cpu::hsm_runs::{HsmRuns, hsm_particles_runs_at};
     use sylva_core::simd::{Level, detected};
     println!("best SIMD level here: {:?}", detected());
-    let wind = WindScene::resolve("gusty").unwrap();
-    let (f, w) = wind.pack();
-    let mut rng = ChaCha8Rng::seed_from_u64(17);
-    let mut cases: Vec<(String, HsmParams, Option<usize>)> =
-        PRESETS.iter().map(|p| (p.name.to_string(), HsmParams::default(), Some(1_500))).collect();
-    cases.push(("quaking_aspen".into(), HsmParams::song_tables(), Some(300)));
-    for (name, params, max) in cases {
-        let t = tree(&name);
-        let layout = HsmLayout::new(&t, &params, max).unwrap();
-        let runs = HsmRuns::new(&layout);
-        assert!(runs.len() < layout.particle_count(), "{name}: no particles share a run");
-        let h = Hsm::from_layout(&t, params, layout);
+    let (f, w) = WindScene::resolve("gusty").unwrap().pack();
+    for (name, h, mut s) in jittered_cases(Vec::new(), 17) {
         let l = &h.layout;
-        let mut s = h.rest_state();
-        for _ in 0..10 {
-            h.step(&f, &w, &mut s, 1.0 / 60.0);
-        }
-        for (u, v) in s.displacement.iter_mut().zip(&mut s.velocity) {
-            if v[3] != FIXED {
-                for c in 0..3 {
-                    u[c] += rng.random_range(-0.05..0.05);
-                    v[c] += rng.random_range(-1.0..1.0);
-                }
-            }
-        }
+        let runs = HsmRuns::new(l);
+        assert!(runs.len() < l.particle_count(), "{name}: no particles share a run");
         let step = h.step_params(s.time + 1.0 / 240.0, 1.0 / 240.0);
         hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &s.displacement, step, &mut s.clusters);
         let mut reference = s.clone();
@@ -484,35 +497,15 @@ fn the_slot_groups_give_the_per_slot_stage_1_bits() {
     use sylva_core::cpu::hsm_slot_groups::{HsmSlotGroups, hsm_clusters_groups_at};
     use sylva_core::simd::{Level, detected};
     println!("best SIMD level here: {:?}", detected());
-    let wind = WindScene::resolve("gusty").unwrap();
-    let (f, w) = wind.pack();
-    let mut rng = ChaCha8Rng::seed_from_u64(29);
-    let mut cases: Vec<(String, HsmParams, Option<usize>)> =
-        PRESETS.iter().map(|p| (p.name.to_string(), HsmParams::default(), Some(1_500))).collect();
-    cases.push(("quaking_aspen".into(), HsmParams::song_tables(), Some(300)));
+    let (f, w) = WindScene::resolve("gusty").unwrap().pack();
     let wide = HsmParams { rings: 6, ring_size: 20, leaf_particles: 21, ..HsmParams::default() };
-    cases.push(("sympodial".into(), wide, Some(200)));
     let sixteen = HsmParams { rings: 2, ring_size: 8, leaf_particles: 16, ..HsmParams::default() };
-    cases.push(("sympodial".into(), sixteen, Some(200)));
+    let extra = vec![("sympodial".into(), wide, Some(200)), ("sympodial".into(), sixteen, Some(200))];
     let mut counts = std::collections::BTreeSet::new();
-    for (name, params, max) in cases {
-        let t = tree(&name);
-        let layout = HsmLayout::new(&t, &params, max).unwrap();
-        let groups = HsmSlotGroups::new(&layout);
-        counts.extend(layout.info.iter().map(|i| i.slot_count));
-        let h = Hsm::from_layout(&t, params, layout);
+    for (name, h, s) in jittered_cases(extra, 29) {
         let l = &h.layout;
-        let mut s = h.rest_state();
-        for _ in 0..10 {
-            h.step(&f, &w, &mut s, 1.0 / 60.0);
-        }
-        for (u, v) in s.displacement.iter_mut().zip(&s.velocity) {
-            if v[3] != FIXED {
-                for c in 0..3 {
-                    u[c] += rng.random_range(-0.05..0.05);
-                }
-            }
-        }
+        let groups = HsmSlotGroups::new(l);
+        counts.extend(l.info.iter().map(|i| i.slot_count));
         let step = h.step_params(s.time + 1.0 / 240.0, 1.0 / 240.0);
         let mut reference = s.clusters.clone();
         hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &s.displacement, step, &mut reference);
