@@ -924,7 +924,7 @@ impl Hsm {
         }
         let particles =
             if self.params.fused { self.runs.bytes_per_pass() } else { l.bytes_per_step(false) - l.stage1_bytes() };
-        self.groups.bytes_per_pass() + particles
+        self.groups.bytes_per_pass(l) + particles
     }
 
     /// The per-substep values the kernels read.

@@ -22,7 +22,7 @@
 
 use super::hsm::{LANES, cluster_sums, hsm_clusters, hsm_clusters_with};
 use super::hsm_runs::{LANE_OF, WIDTH, avx2_at};
-use crate::animate::hsm::{HsmLayout, RawHsmClusterState, RawHsmStep};
+use crate::animate::hsm::{HsmLayout, RawHsmClusterState, RawHsmSlot, RawHsmStep};
 use crate::simd::Level;
 use crate::wind::raw::{RawField, RawWave};
 
@@ -73,13 +73,12 @@ impl HsmSlotGroups {
         Self { offset, count, particle, q, particles }
     }
 
-    /// Bytes [`hsm_clusters_groups`] reads and writes per pass, counted as
-    /// [`HsmLayout::stage1_bytes`] counts them, with the groups (128 B per eight slots) in
-    /// place of the slot records.
-    pub fn bytes_per_pass(&self) -> usize {
-        let clusters = self.count.len();
-        let slots: usize = self.count.iter().map(|&c| c as usize).sum();
-        clusters * (16 + 80 + 2 * 96) + self.particle.len() * (4 * WIDTH + 12 * WIDTH) + slots * 16
+    /// Bytes [`hsm_clusters_groups`] reads and writes per pass over `layout` (the layout the
+    /// groups were made from): [`HsmLayout::stage1_bytes`] with the groups (128 B per eight
+    /// slots, padding included) in place of the slot records (16 B each).
+    pub fn bytes_per_pass(&self, layout: &HsmLayout) -> usize {
+        layout.stage1_bytes() - layout.slots.len() * size_of::<RawHsmSlot>()
+            + self.particle.len() * (size_of::<[u32; WIDTH]>() + size_of::<[[f32; WIDTH]; 3]>())
     }
 
     /// Number of groups.
