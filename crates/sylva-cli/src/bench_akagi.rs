@@ -16,9 +16,9 @@ use plotters::style::RGBColor;
 use serde::Serialize;
 use std::path::PathBuf;
 use sylva_core::Tree;
-use sylva_core::animate::seam_buffers;
-use sylva_core::animate::zioma::{Zioma, ZiomaParams};
 use sylva_core::mesh::{AKAGI_TABLE_2, MeshLayout, MeshParams};
+use sylva_core::methods::zioma::{Zioma, ZiomaParams};
+use sylva_core::pose::seam_buffers;
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 
@@ -134,8 +134,8 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         let mut tubes = vec![bytemuck::Zeroable::zeroed(); layout.tube_vertex_count()];
         let mut leaves = vec![bytemuck::Zeroable::zeroed(); layout.leaf_vertex_count()];
         let mut frame = || {
-            sylva_core::cpu::mesh_tubes(&info, &layout.rings, &layout.segments, &joint, &acc, &mut tubes);
-            sylva_core::cpu::mesh_leaves(&info, &layout.leaves, &layout.segments, &joint, &acc, &mut leaves);
+            sylva_core::mesh::mesh_tubes(&info, &layout.rings, &layout.segments, &joint, &acc, &mut tubes);
+            sylva_core::mesh::mesh_leaves(&info, &layout.leaves, &layout.segments, &joint, &acc, &mut leaves);
         };
         let (cpu_one, cpu_all) = if time_cpu {
             let one = one_thread.install(|| {

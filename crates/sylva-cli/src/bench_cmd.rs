@@ -19,7 +19,7 @@ use plotters::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use sylva_core::animate::hsm::{Hsm, HsmLayout, HsmParams, SONG_TABLE_2, SONG_TABLE_3};
+use sylva_core::methods::hsm::{Hsm, HsmLayout, HsmParams, SONG_TABLE_2, SONG_TABLE_3};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 

@@ -19,10 +19,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 use serde::Serialize;
 use std::path::PathBuf;
-use sylva_core::animate::skjermo::{
+use sylva_core::methods::skjermo::lanes::{StateLanes, StemLanes};
+use sylva_core::methods::skjermo::{
     BENCH_BINARY_TREE, BENCH_FOUR_SINES, RawSkjermoState, RawSkjermoStem, SKJERMO_FIGURE, Skjermo, SkjermoParams,
 };
-use sylva_core::animate::skjermo_lanes::{StateLanes, StemLanes};
 use sylva_core::wind::WindScene;
 use sylva_core::{Grammar, LSystemOptions};
 
@@ -140,7 +140,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
          GeForce 7900 GTX, the wind animation shader alone. MB/update: stem constants and state read, state \
          written; the CPU fast path's lane groups hold {} bytes of constants per stem, the GPU's (and the \
          reference kernel's) records {}. Over 100 % of bandwidth: part of the working set stays in cache.\n\n",
-        std::mem::size_of::<StemLanes>() / sylva_core::animate::skjermo_lanes::LANES,
+        std::mem::size_of::<StemLanes>() / sylva_core::methods::skjermo::lanes::LANES,
         std::mem::size_of::<RawSkjermoStem>()
     );
     md += "| paper branches | paper updates/s | branches | MB/update (CPU / GPU) | CPU updates/s | CPU reference kernel | CPU / paper | CPU % of bandwidth | GPU updates/s | GPU / paper | GPU % of bandwidth | GPU / CPU |\n";

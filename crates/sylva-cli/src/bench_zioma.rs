@@ -19,9 +19,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 use serde::Serialize;
 use std::path::PathBuf;
-use sylva_core::animate::zioma::{ZIOMA_TABLE_6_1, Zioma, ZiomaInstance, ZiomaParams};
-use sylva_core::animate::{Pose, seam_buffers};
 use sylva_core::mesh::{MeshLayout, MeshParams, RawVertex, SkinLayout};
+use sylva_core::methods::zioma::{ZIOMA_TABLE_6_1, Zioma, ZiomaInstance, ZiomaParams};
+use sylva_core::pose::{Pose, seam_buffers};
 use sylva_core::wind::WindScene;
 use sylva_core::{Grammar, LSystemOptions, Tree};
 
@@ -101,7 +101,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         // accumulated rotations written. Skinning: rest vertex and weights read, vertex written.
         let pose_bytes = instances
             * (n_seg * (std::mem::size_of::<sylva_core::model::RawSegment>() + 16 + 16 + 16 + 16)
-                + tree.stems.len() * std::mem::size_of::<sylva_core::animate::zioma::RawZiomaStem>());
+                + tree.stems.len() * std::mem::size_of::<sylva_core::methods::zioma::RawZiomaStem>());
         let skin_bytes = instances * verts * (2 * std::mem::size_of::<RawVertex>() + 16);
         let bytes = pose_bytes + skin_bytes;
         let mut t = 0.0f32;

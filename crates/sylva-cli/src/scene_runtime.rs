@@ -8,12 +8,12 @@
 use anyhow::{Context, Result};
 use glam::{Mat4, Quat, Vec3};
 use std::borrow::Cow;
-use sylva_core::animate::akagi::{Akagi, AkagiParams, AkagiState};
-use sylva_core::animate::hsm::{Hsm, HsmParams, HsmState};
-use sylva_core::animate::skjermo::{Skjermo, SkjermoParams, SkjermoState};
-use sylva_core::animate::zioma::{Zioma, ZiomaInstance, ZiomaParams};
-use sylva_core::animate::{Pose, seam_buffers};
 use sylva_core::mesh::{DeformLayout, DeformerParams, MeshLayout, MeshParams, SkinLayout};
+use sylva_core::methods::akagi::{Akagi, AkagiParams, AkagiState};
+use sylva_core::methods::hsm::{Hsm, HsmParams, HsmState};
+use sylva_core::methods::skjermo::{Skjermo, SkjermoParams, SkjermoState};
+use sylva_core::methods::zioma::{Zioma, ZiomaInstance, ZiomaParams};
+use sylva_core::pose::{Pose, seam_buffers};
 use sylva_core::scene::{BackendChoice, MethodName, Scene, SceneTree};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::raw::{RawField, RawWave};

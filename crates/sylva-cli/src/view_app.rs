@@ -1201,7 +1201,7 @@ fn overlay(
                         1.5,
                         lo.z + (hi.z - lo.z) * (k as f32 + 0.5) / 5.0,
                     );
-                    let v = sylva_core::cpu::wind_sample::wind_at(fields, waves, p, sim.t);
+                    let v = sylva_core::wind::sample::wind_at(fields, waves, p, sim.t);
                     let (Some(a), Some(b)) = (project(p), project(p + v * 0.25)) else { continue };
                     painter.arrow(
                         a,

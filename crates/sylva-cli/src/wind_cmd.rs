@@ -8,8 +8,8 @@ use anyhow::{Context, Result, bail};
 use glam::Vec3;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
-use sylva_core::cpu::wind_sample;
 use sylva_core::wind::WindScene;
+use sylva_core::wind::sample as wind_sample;
 
 pub(crate) const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 

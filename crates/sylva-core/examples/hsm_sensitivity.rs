@@ -9,7 +9,8 @@
 //! file, `STEPS=` default 1000; each tree cut to its first 150 clusters, as the GPU parity
 //! test does).
 
-use sylva_core::animate::hsm::{Hsm, HsmLayout, HsmParams};
+use sylva_core::methods::Method;
+use sylva_core::methods::hsm::{Hsm, HsmLayout, HsmParams};
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
 
@@ -22,14 +23,14 @@ fn main() {
     let steps: usize = env("STEPS", 1000);
     let eps: f32 = env("EPS", 1e-7);
     let noise = std::env::var("NOISE").is_ok();
-    let (f, w) = wind.pack();
+    let fw = wind.packed();
     let dt = 1.0 / 240.0;
     for p in PRESETS {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
         let params = HsmParams { substeps: 1, ..Default::default() };
         let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(150)).unwrap());
-        let mut a = h.rest_state();
-        let mut b = h.rest_state();
+        let mut a = h.state_at_rest();
+        let mut b = h.state_at_rest();
         // A fixed pseudo-random number in [−0.5, 0.5) per particle (and step).
         let hash = |i: usize, k: usize| {
             ((i as u32 ^ (k as u32).wrapping_mul(0x9E37_79B9)).wrapping_mul(2_654_435_761) >> 8) as f32
@@ -45,8 +46,8 @@ fn main() {
         let height = t.height();
         let mut line = String::new();
         for k in 1..=steps {
-            h.step(&f, &w, &mut a, dt);
-            h.step(&f, &w, &mut b, dt);
+            h.step_packed(&fw.fields, &fw.waves, &mut a, dt);
+            h.step_packed(&fw.fields, &fw.waves, &mut b, dt);
             if noise {
                 for (i, x) in b.displacement.iter_mut().enumerate() {
                     x[0] *= 1.0 + hash(i, k).signum() * f32::EPSILON;
@@ -56,7 +57,7 @@ fn main() {
                 line += &format!(" {k}:{:.1e}", a.max_distance(&b) / height);
             }
         }
-        let moved = a.max_distance(&h.rest_state()) / height;
+        let moved = a.max_distance(&h.state_at_rest()) / height;
         println!("{:<16} moved {moved:.2} × height | {line}", p.name);
     }
 }

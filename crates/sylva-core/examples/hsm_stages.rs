@@ -10,8 +10,9 @@
 //! Song's sizes.
 
 use std::time::Instant;
-use sylva_core::animate::hsm::*;
-use sylva_core::cpu::hsm::*;
+use sylva_core::methods::Method;
+use sylva_core::methods::hsm::kernels::*;
+use sylva_core::methods::hsm::*;
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 fn main() {
@@ -23,18 +24,18 @@ fn main() {
     let l = if copies > 1 { one.forest(copies, 30.0).unwrap() } else { one };
     let h = Hsm::from_layout(&tree, params, l);
     let l = &h.layout;
-    let (f, w) = WindScene::resolve(&std::env::var("WIND").unwrap_or("gusty".into())).unwrap().pack();
-    let mut st = h.rest_state();
+    let fw = WindScene::resolve(&std::env::var("WIND").unwrap_or("gusty".into())).unwrap().packed();
+    let mut st = h.state_at_rest();
     let n: usize = std::env::var("N").map(|s| s.parse().unwrap()).unwrap_or(50);
     let only = std::env::var("ONLY").unwrap_or_default();
     for _ in 0..20 {
-        h.step(&f, &w, &mut st, 1.0 / 60.0);
+        h.step_packed(&fw.fields, &fw.waves, &mut st, 1.0 / 60.0);
     }
 
     if only == "digest" {
         // A digest of the state after `N` steps, to check that a change keeps the bits.
         for _ in 0..n {
-            h.step(&f, &w, &mut st, 1.0 / 60.0);
+            h.step_packed(&fw.fields, &fw.waves, &mut st, 1.0 / 60.0);
         }
         let mut d = 0u64;
         for x in st.displacement.iter().chain(&st.velocity).flatten() {
@@ -50,10 +51,10 @@ fn main() {
         let (mut ta, mut tb) = (0.0, 0.0);
         for _ in 0..n {
             let t = Instant::now();
-            four.step(&f, &w, &mut st, 1.0 / 60.0);
+            four.step_packed(&fw.fields, &fw.waves, &mut st, 1.0 / 60.0);
             ta += t.elapsed().as_secs_f64();
             let t = Instant::now();
-            fused.step(&f, &w, &mut st, 1.0 / 60.0);
+            fused.step_packed(&fw.fields, &fw.waves, &mut st, 1.0 / 60.0);
             tb += t.elapsed().as_secs_f64();
         }
         println!("Hsm::step: four-stage {:.1} steps/s, fused {:.1}", n as f64 / ta, n as f64 / tb);
@@ -63,16 +64,24 @@ fn main() {
     if only == "groups" {
         // Stage 1 in the WGSL twin's shape against the CPU's groups of slots, from the same
         // state; the results must agree bit for bit.
-        let groups = sylva_core::cpu::hsm_slot_groups::HsmSlotGroups::new(l);
+        let groups = sylva_core::methods::hsm::slot_groups::HsmSlotGroups::new(l);
         let (mut a, mut b) = (st.clusters.clone(), st.clusters.clone());
         let (mut ta, mut tb) = (0.0, 0.0);
         let mut same = true;
         for _ in 0..n {
             let t = Instant::now();
-            hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut a);
+            hsm_clusters(&fw.fields, &fw.waves, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut a);
             ta += t.elapsed().as_secs_f64();
             let t = Instant::now();
-            sylva_core::cpu::hsm_slot_groups::hsm_clusters_groups(&f, &w, l, &groups, &st.displacement, step, &mut b);
+            sylva_core::methods::hsm::slot_groups::hsm_clusters_groups(
+                &fw.fields,
+                &fw.waves,
+                l,
+                &groups,
+                &st.displacement,
+                step,
+                &mut b,
+            );
             tb += t.elapsed().as_secs_f64();
             same &= bytemuck::cast_slice::<_, u32>(&a) == bytemuck::cast_slice::<_, u32>(&b);
         }
@@ -83,8 +92,8 @@ fn main() {
     if only == "runs" {
         // The fused pass per particle (the WGSL twin's shape) against the CPU's run pass, from
         // the same state; the results must agree bit for bit.
-        let runs = sylva_core::cpu::hsm_runs::HsmRuns::new(l);
-        hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut st.clusters);
+        let runs = sylva_core::methods::hsm::runs::HsmRuns::new(l);
+        hsm_clusters(&fw.fields, &fw.waves, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut st.clusters);
         let (mut a, mut b) = (st.clone(), st.clone());
         let (mut ta, mut tb) = (0.0, 0.0);
         for _ in 0..n {
@@ -100,7 +109,7 @@ fn main() {
             );
             ta += t.elapsed().as_secs_f64();
             let t = Instant::now();
-            sylva_core::cpu::hsm_runs::hsm_particles_runs(
+            sylva_core::methods::hsm::runs::hsm_particles_runs(
                 l,
                 &runs,
                 &b.clusters,
@@ -131,7 +140,16 @@ fn main() {
     for _ in 0..n {
         if only != "fused" {
             timed(&mut t1, &mut || {
-                hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &st.displacement, step, &mut st.clusters)
+                hsm_clusters(
+                    &fw.fields,
+                    &fw.waves,
+                    &l.info,
+                    &l.clusters,
+                    &l.slots,
+                    &st.displacement,
+                    step,
+                    &mut st.clusters,
+                )
             });
         }
         if only.is_empty() {

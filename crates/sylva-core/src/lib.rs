@@ -14,14 +14,15 @@
 //! * [`export`]: static OBJ output, written atomically.
 //! * [`simd`]: eight-lane vectors for the CPU fast paths, with AVX2 where the CPU has it.
 
-pub mod animate;
-pub mod cpu;
 pub mod export;
 pub mod generate;
 pub mod io;
 pub mod limits;
 pub mod mesh;
+pub mod methods;
 pub mod model;
+pub mod physics;
+pub mod pose;
 pub mod rng;
 pub mod scene;
 pub mod simd;

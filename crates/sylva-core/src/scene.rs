@@ -15,7 +15,8 @@
 //! fov_deg = 45
 //! [[tree]]
 //! species = "quaking_aspen"      # a preset, a species TOML or an .lsys grammar
-//! method = "zioma"               # zioma | akagi | skjermo | hsm
+//! method = "zioma"               # zioma | akagi | skjermo | hsm (or a registered one)
+//! params = { amplitude = 1.2 }  # the method's own parameters
 //! position = [-9, 0, 0]
 //! copies = [{ position = [-30, 0, -40], yaw_deg = 40 }]
 //! phase_groups = 4               # akagi/skjermo/hsm: simulations the copies are dealt among
@@ -24,33 +25,50 @@
 //! Unknown keys, wrong types and out-of-range values are errors naming the file, line and
 //! field.
 
-use crate::species::{field_line, line_col};
+use crate::io::{field_line, line_col};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// An animation method by name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum MethodName {
-    /// Zioma, GPU Gems 3 ch. 6 (procedural, stateless).
-    Zioma,
-    /// Akagi & Kitajima §2.5 (force propagation, damped springs).
-    Akagi,
-    /// Skjermo §4 (Bézier bending).
-    Skjermo,
-    /// Song et al. (hierarchical shape matching).
-    Hsm,
-}
+/// An animation method by name, as a scene file spells it (`zioma`, `akagi`, `skjermo`,
+/// `hsm`, or a method an application registered). Which names exist is the runtime's
+/// registry's to say ([`Scene::check_methods`]).
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Deserialize, Serialize)]
+#[serde(transparent)]
+pub struct MethodName(String);
 
 impl MethodName {
-    /// Lower-case name.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::Zioma => "zioma",
-            Self::Akagi => "akagi",
-            Self::Skjermo => "skjermo",
-            Self::Hsm => "hsm",
-        }
+    /// The name `name`.
+    pub fn new(name: impl Into<String>) -> Self {
+        Self(name.into())
+    }
+
+    /// The name.
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+}
+
+impl PartialEq<&str> for MethodName {
+    fn eq(&self, other: &&str) -> bool {
+        self.0 == *other
+    }
+}
+
+impl std::fmt::Display for MethodName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// The text a scene was read from, kept to locate errors found after parsing (a method's
+/// parameters, a name the registry does not know). Not part of a scene's value: two scenes
+/// that differ only in it are equal.
+#[derive(Debug, Clone, Default)]
+pub struct SourceText(pub std::sync::Arc<str>);
+
+impl PartialEq for SourceText {
+    fn eq(&self, _: &Self) -> bool {
+        true
     }
 }
 
@@ -188,6 +206,10 @@ pub struct SceneTree {
     pub seed: u64,
     /// Animation method.
     pub method: MethodName,
+    /// The method's parameters (its `Params` fields by name; absent ones keep their
+    /// defaults), e.g. `params = { damping_ratio = 0.1 }`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub params: Option<toml::Table>,
     /// Position of the root, m.
     #[serde(default)]
     pub position: [f32; 3],
@@ -248,18 +270,16 @@ pub struct PhaseGroup {
 }
 
 impl SceneTree {
-    /// The instances dealt among independent simulations. Zioma's pose is computed per
-    /// instance, so its instances form one group. For the stateful methods there are
-    /// `min(phase_groups, instances)` groups; instance k goes to group k mod groups, and
+    /// The instances dealt among independent simulations. A method that poses every
+    /// instance on its own (`per_instance`, Zioma) keeps its instances in one group. For the
+    /// others there are `min(phase_groups, instances)` groups; instance k goes to group k mod groups, and
     /// group g ≥ 1 starts `PHASE_SPAN_S · frac(g/φ + u)` seconds into the wind (φ the golden
     /// ratio, u from the seed): offsets as evenly spread as a sequence can be, different
     /// for every group.
-    pub fn phase_groups(&self) -> Vec<PhaseGroup> {
+    pub fn phase_groups(&self, per_instance: bool) -> Vec<PhaseGroup> {
         let instances = 1 + self.copies.len();
-        let groups = match self.method {
-            MethodName::Zioma => 1,
-            _ => (self.phase_groups.clamp(1, MAX_PHASE_GROUPS) as usize).min(instances),
-        };
+        let groups =
+            if per_instance { 1 } else { (self.phase_groups.clamp(1, MAX_PHASE_GROUPS) as usize).min(instances) };
         let u = (crate::rng::mix64(self.seed ^ 0x5EED_F00D) >> 40) as f32 / (1u64 << 24) as f32;
         (0..groups)
             .map(|g| PhaseGroup {
@@ -295,6 +315,9 @@ pub struct Scene {
     /// Where the scene came from (for messages).
     #[serde(skip)]
     pub file: String,
+    /// The text it was read from (for messages).
+    #[serde(skip)]
+    pub source: SourceText,
 }
 
 fn default_wind() -> String {
@@ -342,7 +365,7 @@ impl Scene {
     /// Reads a scene file (at most 1 MiB).
     pub fn load(path: &Path) -> Result<Self, SceneError> {
         let file = path.display().to_string();
-        let text = crate::species::read_text(path).map_err(|message| SceneError::Io { file: file.clone(), message })?;
+        let text = crate::io::read_text(path).map_err(|message| SceneError::Io { file: file.clone(), message })?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Self::from_toml(&text, &file, &base)
     }
@@ -355,6 +378,7 @@ impl Scene {
         })?;
         scene.base_dir = base_dir.to_path_buf();
         scene.file = file.to_string();
+        scene.source = SourceText(text.into());
         scene.check().map_err(|(field, value, expected)| SceneError::Value {
             file: file.to_string(),
             line: field_line(text, &field),
@@ -363,6 +387,28 @@ impl Scene {
             expected: expected.to_string(),
         })?;
         Ok(scene)
+    }
+
+    /// The line of the scene's text where `field` (`tree[2].method`) is set; 1 when unknown.
+    pub fn line_of(&self, field: &str) -> usize {
+        crate::io::nested_field_line(&self.source.0, field)
+    }
+
+    /// Checks that every tree's method is one of `known` (the runtime's registry).
+    pub fn check_methods(&self, known: &[&str]) -> Result<(), SceneError> {
+        for (i, t) in self.trees.iter().enumerate() {
+            if !known.contains(&t.method.as_str()) {
+                let field = format!("tree[{i}].method");
+                return Err(SceneError::Value {
+                    file: self.file.clone(),
+                    line: self.line_of(&field),
+                    value: format!("{:?}", t.method.as_str()),
+                    field,
+                    expected: format!("one of {}", known.join(", ")),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Frames to render.
@@ -439,6 +485,10 @@ impl Scene {
         }
         for (i, t) in self.trees.iter().enumerate() {
             let f = |k: &str| format!("tree[{i}].{k}");
+            let m = t.method.as_str();
+            if m.is_empty() || m.len() > 64 || !m.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_') {
+                return err(&f("method"), format!("{m:?}"), "a method name (zioma, akagi, skjermo, hsm or one registered)");
+            }
             if !glam::Vec3::from_array(t.position).is_finite() {
                 return err(&f("position"), format!("{:?}", t.position), "finite coordinates");
             }

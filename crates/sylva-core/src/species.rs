@@ -5,12 +5,10 @@
 
 use crate::generate::lsystem::{Grammar, GrammarError, LSystemError, LSystemOptions};
 use crate::generate::weber_penn::{WeberPennError, WeberPennParams};
+use crate::io::{field_line, line_col, read_text};
 use crate::limits::Limits;
 use crate::model::Tree;
 use std::path::Path;
-
-/// Largest preset or grammar file read, bytes.
-pub const MAX_FILE_BYTES: u64 = 1 << 20;
 
 /// What kind of generator a preset drives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -100,19 +98,6 @@ pub enum SpeciesError {
     WeberPenn { file: String, source: WeberPennError },
 }
 
-/// Reads a text file of at most [`MAX_FILE_BYTES`].
-pub fn read_text(path: &Path) -> Result<String, String> {
-    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(format!(
-            "file is {} bytes, larger than the {} byte limit for presets and grammars",
-            meta.len(),
-            MAX_FILE_BYTES
-        ));
-    }
-    std::fs::read_to_string(path).map_err(|e| e.to_string())
-}
-
 /// A resolved species: what to generate.
 #[derive(Debug, Clone, PartialEq)]
 pub enum SpeciesSource {
@@ -120,50 +105,6 @@ pub enum SpeciesSource {
     WeberPenn { file: String, params: Box<WeberPennParams> },
     /// An L-system grammar.
     LSystem(Box<Grammar>),
-}
-
-/// 1-based line and column of a byte offset.
-pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let col = before.rfind('\n').map_or(before.len(), |i| before.len() - i - 1) + 1;
-    (line, col)
-}
-
-/// Line where a dotted field is set in a TOML file: `name[i].key` in the i-th `[[name]]`
-/// table (`level[1].length`), `name.key` in `[name]` (`wood.density`, `output.fps`), `key` at
-/// the top. The line of the table when the key is absent; 1 when nothing matches (best
-/// effort, for error messages).
-pub(crate) fn field_line(text: &str, field: &str) -> usize {
-    let (table, index, key) = match field.split_once('.') {
-        Some((t, k)) => match t.split_once('[') {
-            Some((name, rest)) => (format!("[[{name}]]"), rest.trim_end_matches(']').parse::<usize>().ok(), k),
-            None => (format!("[{t}]"), None, k),
-        },
-        None => (String::new(), None, field),
-    };
-    let key = key.split('[').next().unwrap_or(key);
-    let mut in_table = table.is_empty();
-    let mut seen = 0usize;
-    let mut table_line = 1;
-    for (i, line) in text.lines().enumerate() {
-        let t = line.trim();
-        if t.starts_with('[') {
-            in_table = false;
-            if !table.is_empty() && t.starts_with(&table) {
-                if index.is_none_or(|n| n == seen) {
-                    in_table = true;
-                    table_line = i + 1;
-                }
-                seen += 1;
-            }
-            continue;
-        }
-        if in_table && t.strip_prefix(key).is_some_and(|r| r.trim_start().starts_with('=')) {
-            return i + 1;
-        }
-    }
-    table_line
 }
 
 impl SpeciesSource {

@@ -1,8 +1,9 @@
 //! Akagi's force propagation with damped angular springs.
 
 use glam::Vec3;
-use sylva_core::animate::Pose;
-use sylva_core::animate::akagi::{Akagi, AkagiParams, max_tip_displacement, mean_shift};
+use sylva_core::methods::Method;
+use sylva_core::methods::akagi::{Akagi, AkagiParams, max_tip_displacement, mean_shift};
+use sylva_core::pose::Pose;
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::{Constant, WindField, WindScene};
 use sylva_core::{Grammar, LSystemOptions, Tree};
@@ -22,7 +23,7 @@ fn still_air_keeps_the_exact_rest_pose() {
         let a = Akagi::new(&t, AkagiParams::default());
         let mut s = a.rest_state(&t);
         for _ in 0..200 {
-            a.step_scene(&t, &WindScene::default(), &mut s, 1.0 / 60.0);
+            a.step(&t, &WindScene::default().packed(), &mut s, 1.0 / 60.0);
         }
         assert_eq!(s.pose, Pose::rest(&t), "{name}");
     }
@@ -35,11 +36,11 @@ fn constant_wind_bends_downwind_more_as_it_rises() {
     let mut last = 0.0;
     for speed in [3.0, 6.0, 12.0, 24.0] {
         let wind = constant(speed);
-        let (f, w) = wind.pack();
+        let fw = wind.packed();
         let mut s = a.rest_state(&t);
         let mut sum = Vec3::ZERO;
         for k in 0..900 {
-            a.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+            a.step(&t, &fw, &mut s, 1.0 / 60.0);
             if k >= 600 {
                 sum += mean_shift(&t, &s.pose);
             }
@@ -70,13 +71,13 @@ fn a_single_cantilever_rings_at_the_spring_frequency() {
     let mut s = a.rest_state(&t);
     let dt = 2e-4 * std::f32::consts::TAU / wn;
     for _ in 0..20_000 {
-        a.step_scene(&t, &constant(15.0), &mut s, dt);
+        a.step(&t, &constant(15.0).packed(), &mut s, dt);
     }
     let calm = WindScene::default();
     let mut crossings = Vec::new();
     let mut prev = s.theta[0][2];
     for k in 0..60_000 {
-        a.step_scene(&t, &calm, &mut s, dt);
+        a.step(&t, &calm.packed(), &mut s, dt);
         let th = s.theta[0][2];
         if prev < 0.0 && th >= 0.0 {
             crossings.push(k as f32 * dt);
@@ -101,7 +102,7 @@ fn motion_dies_away_after_the_wind_stops() {
     let gust = constant(20.0);
     let mut peak: f32 = 0.0;
     for _ in 0..960 {
-        a.step_scene(&t, &gust, &mut s, dt);
+        a.step(&t, &gust.packed(), &mut s, dt);
         peak = peak.max(max_tip_displacement(&t, &s.pose));
     }
     let w_min = (0..t.segments.len()).map(|i| a.natural_frequency(i)).fold(f32::MAX, f32::min);
@@ -110,7 +111,7 @@ fn motion_dies_away_after_the_wind_stops() {
     let mut settled_at = None;
     let mut k = 0;
     while (k as f32) * dt < 2.0 * predicted {
-        a.step_scene(&t, &calm, &mut s, dt);
+        a.step(&t, &calm.packed(), &mut s, dt);
         k += 1;
         let d = max_tip_displacement(&t, &s.pose);
         if d < 0.01 * peak && settled_at.is_none() {
@@ -130,11 +131,11 @@ fn a_100_000_step_storm_stays_sound() {
     if let WindField::Constant(c) = &mut wind.fields[0] {
         c.speed = 40.0;
     }
-    let (f, w) = wind.pack();
+    let fw = wind.packed();
     let a = Akagi::new(&t, AkagiParams::default());
     let mut s = a.rest_state(&t);
     for k in 0..100_000 {
-        a.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+        a.step(&t, &fw, &mut s, 1.0 / 60.0);
         if k % 5_000 == 0 || k == 99_999 {
             if let Err(e) = s.pose.check_sound(&t) {
                 panic!("step {k}: {e}");
@@ -152,7 +153,7 @@ fn akagi_is_identical_on_any_thread_count() {
             let a = Akagi::new(&t, AkagiParams::default());
             let mut s = a.rest_state(&t);
             for _ in 0..60 {
-                a.step_scene(&t, &wind, &mut s, 1.0 / 60.0);
+                a.step(&t, &wind.packed(), &mut s, 1.0 / 60.0);
             }
             s
         })

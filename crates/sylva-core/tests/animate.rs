@@ -1,8 +1,8 @@
 //! The pose seam and Zioma's method.
 
 use glam::{Quat, Vec3};
-use sylva_core::animate::zioma::{Lod, Zioma, ZiomaParams};
-use sylva_core::animate::{Pose, displacement};
+use sylva_core::methods::zioma::{Lod, Zioma, ZiomaParams};
+use sylva_core::pose::{Pose, displacement};
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::{Constant, WindField, WindScene};
 use sylva_core::{Grammar, LSystemOptions, Tree};
@@ -47,14 +47,14 @@ fn zioma_in_still_air_is_exactly_at_rest() {
         let t = SpeciesSource::from_preset(p).unwrap().generate(2, &Default::default(), None).unwrap();
         let z = Zioma::new(&t, ZiomaParams::default());
         for time in [0.0, 3.7, 1000.0] {
-            assert_eq!(z.pose(&t, &WindScene::default(), time), Pose::rest(&t), "{} at {time}", p.name);
+            assert_eq!(z.pose_at(&t, &WindScene::default().packed(), time), Pose::rest(&t), "{} at {time}", p.name);
         }
     }
 }
 
 /// Mean crown displacement over many times, in constant wind.
 fn mean_crown_shift(t: &Tree, z: &Zioma, wind: &WindScene) -> Vec3 {
-    (0..24).map(|k| displacement(t, &z.pose(t, wind, 0.37 * k as f32)).crown_mean).sum::<Vec3>() / 24.0
+    (0..24).map(|k| displacement(t, &z.pose_at(t, &wind.packed(), 0.37 * k as f32)).crown_mean).sum::<Vec3>() / 24.0
 }
 
 #[test]
@@ -82,16 +82,16 @@ fn zioma_is_stateless_and_thread_independent() {
     let t = tree("black_tupelo");
     let wind = WindScene::resolve("gusty").unwrap();
     let z = Zioma::new(&t, ZiomaParams::default());
-    let fresh = Zioma::new(&t, ZiomaParams::default()).pose(&t, &wind, 12.5);
+    let fresh = Zioma::new(&t, ZiomaParams::default()).pose_at(&t, &wind.packed(), 12.5);
     for k in 0..20 {
-        z.pose(&t, &wind, k as f32 * 0.9);
+        z.pose_at(&t, &wind.packed(), k as f32 * 0.9);
     }
-    assert_eq!(z.pose(&t, &wind, 12.5), fresh);
+    assert_eq!(z.pose_at(&t, &wind.packed(), 12.5), fresh);
     let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
-    let one = pool(1).install(|| z.pose(&t, &wind, 7.25));
-    let three = pool(3).install(|| z.pose(&t, &wind, 7.25));
+    let one = pool(1).install(|| z.pose_at(&t, &wind.packed(), 7.25));
+    let three = pool(3).install(|| z.pose_at(&t, &wind.packed(), 7.25));
     assert_eq!(one, three);
-    assert_ne!(z.pose(&t, &wind, 7.25), z.pose(&t, &wind, 7.5), "the tree does not move");
+    assert_ne!(z.pose_at(&t, &wind.packed(), 7.25), z.pose_at(&t, &wind.packed(), 7.5), "the tree does not move");
 }
 
 /// Zioma is stateless, so 100,000 steps at 60 Hz (1,667 s) are covered by poses at times
@@ -107,7 +107,7 @@ fn zioma_in_a_40_m_per_s_gusty_storm_stays_sound() {
         let z = Zioma::new(&t, ZiomaParams::default());
         for k in 0..40 {
             let time = k as f32 * (100_000.0 / 60.0 / 40.0) + 0.123;
-            let pose = z.pose(&t, &wind, time);
+            let pose = z.pose_at(&t, &wind.packed(), time);
             if let Err(e) = pose.check_sound(&t) {
                 panic!("{name} at {time}: {e}");
             }
@@ -129,6 +129,6 @@ fn trunk_only_lod_moves_branches_rigidly() {
     let full = Zioma::new(&t, ZiomaParams::default()).rotations(&t, &wind, 4.0);
     assert!((0..t.segments.len()).any(|i| t.segments.level[i] > 0 && full[i] != [0.0, 0.0, 0.0, 1.0]));
     // The trunk moves the same way in both.
-    let pose = z.pose(&t, &wind, 4.0);
+    let pose = z.pose_at(&t, &wind.packed(), 4.0);
     assert!(displacement(&t, &pose).max[0] > 0.0);
 }

@@ -6,13 +6,14 @@
 use glam::{Mat4, Quat, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::export::gltf::tangents;
 use sylva_core::export::{
     BakeError, BakeParams, Clip, DEFAULT_LODS, GltfError, GltfOptions, JointMode, Lod, bake, build_gltf, write_gltf,
 };
 use sylva_core::mesh::{MeshLayout, MeshParams, SkinLayout};
-use sylva_core::scene::MethodName;
+use sylva_core::methods::{Animator, MethodOptions, akagi, hsm, skjermo, zioma};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 
@@ -24,9 +25,21 @@ fn gusty() -> WindScene {
     WindScene::resolve("gusty").unwrap()
 }
 
-fn clip(t: &Tree, method: MethodName, seconds: f32, looped: bool) -> Clip {
-    let p = BakeParams { method, seconds, fps: 30.0, looped, blend: 0.5, preroll: 0.5, ..Default::default() };
-    bake(t, &gusty(), &p, &mut |_, _| {}).unwrap()
+/// `method` on `t` at rest, seed 1.
+fn animator(t: &Tree, method: &str) -> Box<dyn Animator> {
+    let build = match method {
+        "zioma" => zioma::animator,
+        "akagi" => akagi::animator,
+        "skjermo" => skjermo::animator,
+        "hsm" => hsm::animator,
+        m => panic!("no method {m}"),
+    };
+    build(Arc::new(t.clone()), &MethodOptions::seeded(1)).unwrap()
+}
+
+fn clip(t: &Tree, method: &str, seconds: f32, looped: bool) -> Clip {
+    let p = BakeParams { seconds, fps: 30.0, looped, blend: 0.5, preroll: 0.5, ..Default::default() };
+    bake(animator(t, method).as_mut(), &gusty(), &p, &mut |_, _| {}).unwrap()
 }
 
 fn glb(t: &Tree, c: Option<&Clip>, opts: &GltfOptions) -> Vec<u8> {
@@ -71,13 +84,13 @@ fn every_kind_of_export_passes_the_khronos_validator_with_no_errors_or_warnings(
         write_gltf(t, c, &opts, &path).unwrap();
         files.push(path);
     };
-    let looped = clip(&palm, MethodName::Akagi, 1.5, true);
+    let looped = clip(&palm, "akagi", 1.5, true);
     write("palm_akagi_loop.glb", &palm, Some(&looped), GltfOptions::default());
     write("palm_akagi_loop.gltf", &palm, Some(&looped), GltfOptions::default());
-    let hsm = clip(&palm, MethodName::Hsm, 0.5, false);
+    let hsm = clip(&palm, "hsm", 0.5, false);
     write("palm_hsm_stems.glb", &palm, Some(&hsm), GltfOptions { joints: JointMode::Stem, ..Default::default() });
     write("palm_static.glb", &palm, None, GltfOptions::default());
-    let zioma = clip(&willow, MethodName::Zioma, 0.5, false);
+    let zioma = clip(&willow, "zioma", 0.5, false);
     write(
         "lsystem_zioma.gltf",
         &willow,
@@ -252,7 +265,7 @@ fn translation_channels(doc: &sylva_core::export::GltfDocument) -> usize {
 fn skin_and_animation_read_back_reproduce_sylvas_mesh_at_frame_k_rotation_channels() {
     // Akagi keeps segments attached by forward kinematics: rotation channels only.
     let t = tree("palm");
-    let c = clip(&t, MethodName::Akagi, 1.0, false);
+    let c = clip(&t, "akagi", 1.0, false);
     let doc = build_gltf(&t, Some(&c), &GltfOptions::default()).unwrap();
     let translations = translation_channels(&doc);
     assert_eq!(translations, 0, "forward kinematics needs no translation channels");
@@ -265,7 +278,7 @@ fn skin_and_animation_read_back_reproduce_sylvas_mesh_at_frame_k_with_translatio
     // (cluster centres, a stretchy method) needs translation channels. Make one from an HSM
     // clip by moving every joint off its parent's by a few millimetres, differently per frame.
     let t = tree("palm");
-    let mut c = clip(&t, MethodName::Hsm, 0.5, false);
+    let mut c = clip(&t, "hsm", 0.5, false);
     for (f, frame) in c.joints.iter_mut().enumerate() {
         for (i, j) in frame.iter_mut().enumerate() {
             let phase = (i * 7 + f * 3) as f32 * 0.37;
@@ -282,7 +295,7 @@ fn skin_and_animation_read_back_reproduce_sylvas_mesh_at_frame_k_with_translatio
 #[test]
 fn joints_per_stem_move_each_stem_rigidly_about_its_base() {
     let t = tree("palm");
-    let c = clip(&t, MethodName::Akagi, 0.5, false);
+    let c = clip(&t, "akagi", 0.5, false);
     let opts = GltfOptions { joints: JointMode::Stem, ..Default::default() };
     let rb = read_back(&glb(&t, Some(&c), &opts));
     assert_eq!(rb.skin_nodes.len(), t.stems.len());
@@ -308,8 +321,8 @@ fn joints_per_stem_move_each_stem_rigidly_about_its_base() {
 fn looping_clip_is_seamless_in_pose_and_angular_velocity() {
     let t = tree("palm");
     let fps = 30.0;
-    let looped = clip(&t, MethodName::Akagi, 3.0, true);
-    let cut = clip(&t, MethodName::Akagi, 3.0, false);
+    let looped = clip(&t, "akagi", 3.0, true);
+    let cut = clip(&t, "akagi", 3.0, false);
     let rb = read_back(&glb(&t, Some(&looped), &GltfOptions::default()));
     let n = looped.frames() - 1;
     assert_eq!(n, 90);
@@ -397,7 +410,7 @@ fn hierarchy_attributes_tangents_and_static_export_mean_what_the_docs_say() {
         assert_eq!(phase[i], phase[i + leaf_stride - 1]);
     }
     // Tangents: unit, orthogonal to the normal, handedness ±1.
-    let m = layout.mesh(&t, &sylva_core::animate::Pose::rest(&t));
+    let m = layout.mesh(&t, &sylva_core::pose::Pose::rest(&t));
     for (verts, idx) in [(&m.tubes, &layout.tube_indices), (&m.leaves, &layout.leaf_indices)] {
         for (v, tg) in verts.iter().zip(tangents(verts, idx)) {
             let tv = Vec3::new(tg[0], tg[1], tg[2]);
@@ -435,8 +448,8 @@ fn levels_of_detail_shrink_and_keep_the_leaf_area() {
 #[test]
 fn the_same_inputs_give_the_same_bytes() {
     let t = tree("palm");
-    let c1 = clip(&t, MethodName::Zioma, 1.5, true);
-    let c2 = clip(&t, MethodName::Zioma, 1.5, true);
+    let c1 = clip(&t, "zioma", 1.5, true);
+    let c2 = clip(&t, "zioma", 1.5, true);
     assert_eq!(glb(&t, Some(&c1), &GltfOptions::default()), glb(&t, Some(&c2), &GltfOptions::default()));
 }
 
@@ -447,7 +460,7 @@ fn the_same_inputs_give_the_same_bytes() {
 fn bad_inputs_are_refused_by_name_and_leave_no_file() {
     let t = tree("palm");
     let wind = gusty();
-    let bad = |p: BakeParams| bake(&t, &wind, &p, &mut |_, _| {}).unwrap_err();
+    let bad = |p: BakeParams| bake(animator(&t, "zioma").as_mut(), &wind, &p, &mut |_, _| {}).unwrap_err();
     let field = |e: BakeError| match e {
         BakeError::Param { field, .. } => field,
         e => panic!("expected a parameter error, got {e}"),
@@ -462,7 +475,7 @@ fn bad_inputs_are_refused_by_name_and_leave_no_file() {
         BakeError::TooLarge { .. }
     ));
 
-    let c = clip(&t, MethodName::Zioma, 0.2, false);
+    let c = clip(&t, "zioma", 0.2, false);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("tree.glb");
     let e = write_gltf(&t, Some(&c), &GltfOptions { max_joints: Some(100), ..Default::default() }, &path).unwrap_err();

@@ -3,12 +3,13 @@
 use glam::{DQuat, DVec3, Mat3, Quat, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use sylva_core::animate::Pose;
-use sylva_core::animate::akagi::max_tip_displacement;
-use sylva_core::animate::hsm::{FIXED, Hsm, HsmLayout, HsmParams, HsmState, RawHsmClusterState};
-use sylva_core::cpu::hsm::{extract_rotation, hsm_clusters, hsm_goals};
+use sylva_core::methods::Method;
+use sylva_core::methods::akagi::max_tip_displacement;
+use sylva_core::methods::hsm::kernels::{extract_rotation, hsm_clusters, hsm_goals};
+use sylva_core::methods::hsm::{FIXED, Hsm, HsmLayout, HsmParams, HsmState, RawHsmClusterState};
+use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
-use sylva_core::wind::{WindField, WindScene};
+use sylva_core::wind::{PackedWind, WindField, WindScene};
 use sylva_core::{Tree, TreeBuilder, WoodProperties};
 
 fn tree(name: &str) -> Tree {
@@ -42,7 +43,7 @@ fn a_rigidly_moved_cluster_has_goals_at_its_positions() {
     for trial in 0..20 {
         let r = random_rotation(&mut rng, 2.1);
         let shift = Vec3::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0));
-        let mut s = h.rest_state();
+        let mut s = h.state_at_rest();
         for (u, x0) in s.displacement.iter_mut().zip(&l.rest) {
             let x0 = Vec3::new(x0[0], x0[1], x0[2]);
             let d = (r * x0 + shift) - x0;
@@ -218,10 +219,10 @@ fn a_cantilever_sags_the_same_whatever_the_substeps() {
         let alpha_max =
             h.layout.clusters.iter().map(|c| c.rest_cm[3]).fold(0.0, f32::max) / (240.0 * substeps as f32).powi(2);
         assert!(alpha_max < 1.0, "α {alpha_max} clamps: the test needs a soft chain");
-        let mut s = h.rest_state();
+        let mut s = h.state_at_rest();
         let steps = h.settle(&mut s, 1.0 / 240.0, 40_000, 1e-8);
         assert!(steps < 20_000, "{substeps} substeps: never settled");
-        let tip = h.pose(&t, &s).end(&t, 5);
+        let tip = h.pose(&t, &PackedWind::calm(), &s).end(&t, 5);
         let rest = t.segments.end(5);
         sags.push(tip - rest);
     }
@@ -260,14 +261,14 @@ fn a_stiff_bush_does_not_lie_down_in_gusty_wind() {
 /// The largest distance of any segment end from rest over 4 s of `gusty` at 60 frames/s,
 /// with the wood's stiffness scaled by `stiffness_scale`.
 fn most_bending(t: &Tree, stiffness_scale: f32) -> f32 {
-    let (f, w) = WindScene::resolve("gusty").unwrap().pack();
+    let fw = WindScene::resolve("gusty").unwrap().packed();
     let h = Hsm::new(t, HsmParams { stiffness_scale, ..Default::default() }).unwrap();
-    let mut s = h.rest_state();
+    let mut s = h.state_at_rest();
     let mut most = 0.0f32;
     for k in 0..240 {
-        h.step(&f, &w, &mut s, 1.0 / 60.0);
+        h.step_packed(&fw.fields, &fw.waves, &mut s, 1.0 / 60.0);
         if k % 6 == 5 {
-            most = most.max(max_tip_displacement(t, &h.pose(t, &s)));
+            most = most.max(max_tip_displacement(t, &h.pose(t, &PackedWind::calm(), &s)));
         }
     }
     most
@@ -292,13 +293,13 @@ fn still_air_keeps_the_exact_rest_pose() {
     for name in ["monopodial", "quaking_aspen"] {
         let t = tree(name);
         let h = Hsm::new(&t, HsmParams::default()).unwrap();
-        let mut s = h.rest_state();
+        let mut s = h.state_at_rest();
         let rest = s.clone();
         for _ in 0..60 {
-            h.step_scene(&WindScene::default(), &mut s, 1.0 / 60.0);
+            h.step(&t, &&WindScene::default().packed(), &mut s, 1.0 / 60.0);
         }
         assert_eq!(s.displacement, rest.displacement, "{name}");
-        assert_eq!(h.pose(&t, &s), Pose::rest(&t), "{name}");
+        assert_eq!(h.pose(&t, &PackedWind::calm(), &s), Pose::rest(&t), "{name}");
     }
 }
 
@@ -313,22 +314,22 @@ fn max_speed(s: &HsmState) -> f32 {
 fn a_100_000_step_storm_stays_stable_and_recovers() {
     let t = tree("stochastic_bush");
     let h = Hsm::new(&t, HsmParams::default()).unwrap();
-    let (f, w) = storm(40.0).pack();
-    let mut s = h.rest_state();
+    let fw = storm(40.0).packed();
+    let mut s = h.state_at_rest();
     let rest = s.clone();
     for k in 0..100_000 {
-        h.step(&f, &w, &mut s, 1.0 / 60.0);
+        h.step_packed(&fw.fields, &fw.waves, &mut s, 1.0 / 60.0);
         if k % 5_000 == 0 || k == 99_999 {
             assert!(s.displacement.iter().all(|p| p.iter().all(|v| v.is_finite())), "step {k}: NaN");
             let v = max_speed(&s);
             assert!(v < 80.0, "step {k}: a particle at {v} m/s");
-            if let Err(e) = h.pose(&t, &s).check_sound(&t) {
+            if let Err(e) = h.pose(&t, &PackedWind::calm(), &s).check_sound(&t) {
                 panic!("step {k}: {e}");
             }
         }
     }
     for _ in 0..1_200 {
-        h.step(&[], &[], &mut s, 1.0 / 60.0);
+        h.step_packed(&[], &[], &mut s, 1.0 / 60.0);
     }
     let d = s.max_distance(&rest);
     assert!(d <= 0.01 * t.height(), "20 s after the storm a particle is {d} m from rest");
@@ -338,24 +339,24 @@ fn a_100_000_step_storm_stays_stable_and_recovers() {
 /// finite and bounded, and 20 s of calm bring it back within 1 % of its height.
 #[test]
 fn every_preset_survives_a_storm_and_returns_to_rest() {
-    let (f, w) = storm(40.0).pack();
+    let fw = storm(40.0).packed();
     for p in PRESETS {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
         let params = HsmParams::default();
         let layout = HsmLayout::new(&t, &params, Some(600)).unwrap();
         let h = Hsm::from_layout(&t, params, layout);
-        let mut s = h.rest_state();
+        let mut s = h.state_at_rest();
         let rest = s.clone();
         let mut peak = 0.0f32;
         for _ in 0..1_000 {
-            h.step(&f, &w, &mut s, 1.0 / 60.0);
+            h.step_packed(&fw.fields, &fw.waves, &mut s, 1.0 / 60.0);
             peak = peak.max(s.max_distance(&rest));
         }
         assert!(s.displacement.iter().all(|p| p.iter().all(|v| v.is_finite())), "{}: NaN", p.name);
         assert!(max_speed(&s) < 80.0, "{}: a particle at {} m/s", p.name, max_speed(&s));
         assert!(peak > 1e-3, "{}: the storm moved nothing", p.name);
         for _ in 0..1_200 {
-            h.step(&[], &[], &mut s, 1.0 / 60.0);
+            h.step_packed(&[], &[], &mut s, 1.0 / 60.0);
         }
         let d = s.max_distance(&rest);
         let height = t.height();
@@ -378,16 +379,16 @@ fn hsm_is_identical_on_any_thread_count() {
     let h = Hsm::from_layout(&t, params, layout);
     let run = |n| {
         rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap().install(|| {
-            let mut s = h.rest_state();
+            let mut s = h.state_at_rest();
             for _ in 0..60 {
-                h.step_scene(&wind, &mut s, 1.0 / 60.0);
+                h.step(&t, &&wind.packed(), &mut s, 1.0 / 60.0);
             }
             s
         })
     };
     let one = run(1);
     assert_eq!(one, run(3));
-    assert_ne!(one.displacement, h.rest_state().displacement);
+    assert_ne!(one.displacement, h.state_at_rest().displacement);
 }
 
 /// The fused particle pass (stages 3 and 4 in one) gives Song's four stages bit for bit.
@@ -400,9 +401,9 @@ fn fused_particle_stages_match_the_four_stages_exactly() {
     let layout = HsmLayout::new(&t, &four, Some(2_000)).unwrap();
     let run = |params| {
         let h = Hsm::from_layout(&t, params, layout.clone());
-        let mut s = h.rest_state();
+        let mut s = h.state_at_rest();
         for _ in 0..120 {
-            h.step_scene(&wind, &mut s, 1.0 / 60.0);
+            h.step(&t, &&wind.packed(), &mut s, 1.0 / 60.0);
         }
         s
     };
@@ -419,7 +420,7 @@ fn fused_particle_stages_match_the_four_stages_exactly() {
 /// 5 cm and its velocity by up to 1 m/s (seeded): states on which the CPU's fast forms must
 /// give the bits of the WGSL twins' shapes.
 fn jittered_cases(extra: Vec<(String, HsmParams, Option<usize>)>, seed: u64) -> Vec<(String, Hsm, HsmState)> {
-    let (f, w) = WindScene::resolve("gusty").unwrap().pack();
+    let fw = WindScene::resolve("gusty").unwrap().packed();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut cases: Vec<(String, HsmParams, Option<usize>)> =
         PRESETS.iter().map(|p| (p.name.to_string(), HsmParams::default(), Some(1_500))).collect();
@@ -430,9 +431,9 @@ fn jittered_cases(extra: Vec<(String, HsmParams, Option<usize>)>, seed: u64) -> 
         .map(|(name, params, max)| {
             let t = tree(&name);
             let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, max).unwrap());
-            let mut s = h.rest_state();
+            let mut s = h.state_at_rest();
             for _ in 0..10 {
-                h.step(&f, &w, &mut s, 1.0 / 60.0);
+                h.step_packed(&fw.fields, &fw.waves, &mut s, 1.0 / 60.0);
             }
             for (u, v) in s.displacement.iter_mut().zip(&mut s.velocity) {
                 if v[3] != FIXED {
@@ -454,17 +455,17 @@ fn jittered_cases(extra: Vec<(String, HsmParams, Option<usize>)>, seed: u64) -> 
 /// of 42), from states a gusty wind has moved plus random noise on every free particle.
 #[test]
 fn the_run_pass_gives_the_per_particle_pass_bits() {
-    use sylva_core::cpu::hsm::hsm_particles;
-    use sylva_core::cpu::hsm_runs::{HsmRuns, hsm_particles_runs_at};
+    use sylva_core::methods::hsm::kernels::hsm_particles;
+    use sylva_core::methods::hsm::runs::{HsmRuns, hsm_particles_runs_at};
     use sylva_core::simd::{Level, detected};
     println!("best SIMD level here: {:?}", detected());
-    let (f, w) = WindScene::resolve("gusty").unwrap().pack();
+    let fw = WindScene::resolve("gusty").unwrap().packed();
     for (name, h, mut s) in jittered_cases(Vec::new(), 17) {
         let l = &h.layout;
         let runs = HsmRuns::new(l);
         assert!(runs.len() < l.particle_count(), "{name}: no particles share a run");
         let step = h.step_params(s.time + 1.0 / 240.0, 1.0 / 240.0);
-        hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &s.displacement, step, &mut s.clusters);
+        hsm_clusters(&fw.fields, &fw.waves, &l.info, &l.clusters, &l.slots, &s.displacement, step, &mut s.clusters);
         let mut reference = s.clone();
         hsm_particles(
             &l.member_offset,
@@ -494,10 +495,10 @@ fn the_run_pass_gives_the_per_particle_pass_bits() {
 /// noise on every free particle.
 #[test]
 fn the_slot_groups_give_the_per_slot_stage_1_bits() {
-    use sylva_core::cpu::hsm_slot_groups::{HsmSlotGroups, hsm_clusters_groups_at};
+    use sylva_core::methods::hsm::slot_groups::{HsmSlotGroups, hsm_clusters_groups_at};
     use sylva_core::simd::{Level, detected};
     println!("best SIMD level here: {:?}", detected());
-    let (f, w) = WindScene::resolve("gusty").unwrap().pack();
+    let fw = WindScene::resolve("gusty").unwrap().packed();
     let wide = HsmParams { rings: 6, ring_size: 20, leaf_particles: 21, ..HsmParams::default() };
     let sixteen = HsmParams { rings: 2, ring_size: 8, leaf_particles: 16, ..HsmParams::default() };
     let extra = vec![("sympodial".into(), wide, Some(200)), ("sympodial".into(), sixteen, Some(200))];
@@ -508,12 +509,12 @@ fn the_slot_groups_give_the_per_slot_stage_1_bits() {
         counts.extend(l.info.iter().map(|i| i.slot_count));
         let step = h.step_params(s.time + 1.0 / 240.0, 1.0 / 240.0);
         let mut reference = s.clusters.clone();
-        hsm_clusters(&f, &w, &l.info, &l.clusters, &l.slots, &s.displacement, step, &mut reference);
+        hsm_clusters(&fw.fields, &fw.waves, &l.info, &l.clusters, &l.slots, &s.displacement, step, &mut reference);
         assert_ne!(reference, s.clusters, "{name}: nothing moved");
         let bits = |a: &[RawHsmClusterState]| bytemuck::cast_slice::<_, u32>(a).to_vec();
         for level in [Level::Baseline, Level::Avx2] {
             let mut b = s.clusters.clone();
-            hsm_clusters_groups_at(level, &f, &w, l, &groups, &s.displacement, step, &mut b);
+            hsm_clusters_groups_at(level, &fw.fields, &fw.waves, l, &groups, &s.displacement, step, &mut b);
             assert!(bits(&b) == bits(&reference), "{name} {level:?}: cluster states differ");
         }
     }
@@ -593,9 +594,9 @@ fn the_state_holds_displacements_and_fixed_particles_never_move() {
     let h = Hsm::new(&t, HsmParams::default()).unwrap();
     let l = &h.layout;
     let wind = storm(30.0);
-    let mut s = h.rest_state();
+    let mut s = h.state_at_rest();
     for _ in 0..240 {
-        h.step_scene(&wind, &mut s, 1.0 / 60.0);
+        h.step(&t, &&wind.packed(), &mut s, 1.0 / 60.0);
     }
     let positions = h.positions(&s);
     assert_eq!(positions.len(), l.particle_count());
@@ -614,5 +615,5 @@ fn the_state_holds_displacements_and_fixed_particles_never_move() {
         assert_eq!(*p, want);
     }
     assert!(fixed > 0, "the root ring is fixed");
-    assert!(s.max_distance(&h.rest_state()) > 1e-3, "the storm moved the bush");
+    assert!(s.max_distance(&h.state_at_rest()) > 1e-3, "the storm moved the bush");
 }

@@ -4,8 +4,9 @@
 use glam::{Quat, Vec3};
 use rand::{Rng, SeedableRng};
 use sylva_core::Tree;
-use sylva_core::animate::Pose;
 use sylva_core::mesh::{MeshError, MeshFrame, MeshLayout, MeshParams, RawVertex};
+use sylva_core::methods::Method;
+use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
 
 fn tree(name: &str) -> Tree {
@@ -192,8 +193,8 @@ fn a_forest_layout_meshes_like_its_trees() {
     let (la, lb) = (MeshLayout::new(&a, p).unwrap(), MeshLayout::new(&b, p).unwrap());
     let forest = MeshLayout::concat(&[&la, &lb]).unwrap();
     let (pa, pb) = (random_pose(&a, 1, 0.1), random_pose(&b, 2, 0.1));
-    let (mut joint, mut acc) = sylva_core::mesh::pose_buffers(&a, &pa);
-    let (jb, ab) = sylva_core::mesh::pose_buffers(&b, &pb);
+    let (mut joint, mut acc) = sylva_core::pose::pose_buffers(&a, &pa);
+    let (jb, ab) = sylva_core::pose::pose_buffers(&b, &pb);
     joint.extend(jb);
     acc.extend(ab);
     let m = forest.mesh_raw(&joint, &acc);
@@ -225,7 +226,7 @@ fn skinning_follows_the_pose_and_keeps_joint_rings_on_their_joints() {
     let h = t.height();
     // At rest the skinned mesh is the rest mesh.
     let rest = l.mesh(&t, &Pose::rest(&t));
-    let (j, a) = sylva_core::mesh::pose_buffers(&t, &Pose::rest(&t));
+    let (j, a) = sylva_core::pose::pose_buffers(&t, &Pose::rest(&t));
     let same = skin.skin(&j, &a, 1);
     for (x, y) in rest.tubes.iter().zip(&same.tubes).chain(rest.leaves.iter().zip(&same.leaves)) {
         assert!((pos(x) - pos(y)).length() <= 1e-6 * h);
@@ -235,7 +236,7 @@ fn skinning_follows_the_pose_and_keeps_joint_rings_on_their_joints() {
     let poses = [random_pose(&t, 5, 0.15), random_pose(&t, 6, 0.15)];
     let (mut joint, mut acc) = (Vec::new(), Vec::new());
     for p in &poses {
-        let (j, a) = sylva_core::mesh::pose_buffers(&t, p);
+        let (j, a) = sylva_core::pose::pose_buffers(&t, p);
         joint.extend(j);
         acc.extend(a);
     }
@@ -262,21 +263,21 @@ fn skinning_follows_the_pose_and_keeps_joint_rings_on_their_joints() {
 
 mod deformer {
     use super::*;
-    use sylva_core::animate::skjermo::{Skjermo, SkjermoParams, bezier};
     use sylva_core::mesh::{DeformLayout, DeformerParams, RawDeformShape, deform_radius};
+    use sylva_core::methods::skjermo::{Skjermo, SkjermoParams, bezier};
     use sylva_core::wind::WindScene;
 
     fn deform(
         layout: &DeformLayout,
         m: &Skjermo,
-        state: &[sylva_core::animate::skjermo::RawSkjermoState],
+        state: &[sylva_core::methods::skjermo::RawSkjermoState],
     ) -> Vec<RawVertex> {
         let mut out = vec![bytemuck::Zeroable::zeroed(); layout.vertex_count()];
-        sylva_core::cpu::skjermo_deform(&layout.info(), &layout.rings, &layout.shapes, &m.stems, state, &mut out);
+        sylva_core::mesh::skjermo_deform(&layout.info(), &layout.rings, &layout.shapes, &m.stems, state, &mut out);
         out
     }
 
-    fn curve(m: &Skjermo, state: &[sylva_core::animate::skjermo::RawSkjermoState], k: usize) -> [Vec3; 4] {
+    fn curve(m: &Skjermo, state: &[sylva_core::methods::skjermo::RawSkjermoState], k: usize) -> [Vec3; 4] {
         [0, 1, 2, 3].map(|j| Vec3::from_slice(&m.stems[k].rest[j][..3]) + Vec3::from_slice(&state[k].delta[j][..3]))
     }
 
@@ -292,7 +293,7 @@ mod deformer {
         let m = Skjermo::new(&t, SkjermoParams::default());
         let mut state = m.rest_state(&t);
         let wind = WindScene::resolve("gusty").unwrap();
-        let (fields, waves) = wind.pack();
+        let fieldswaves = wind.packed();
         let stride = p.sides as usize + 1;
         for round in 0..2 {
             let v = deform(&layout, &m, &state.stems);
@@ -328,7 +329,7 @@ mod deformer {
             }
             // Bend the curves and check again.
             for _ in 0..30 {
-                m.step(&t, &fields, &waves, &mut state, 1.0 / 30.0);
+                m.step(&t, &fieldswaves, &mut state, 1.0 / 30.0);
             }
             assert!(state.stems.iter().any(|s| s.delta[3][0] != 0.0), "the wind bent nothing");
         }

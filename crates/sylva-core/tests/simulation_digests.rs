@@ -6,13 +6,14 @@
 
 use sha2::{Digest, Sha256};
 use sylva_core::Tree;
-use sylva_core::animate::Pose;
-use sylva_core::animate::akagi::{Akagi, AkagiParams};
-use sylva_core::animate::hsm::{Hsm, HsmParams};
-use sylva_core::animate::skjermo::{Skjermo, SkjermoParams};
-use sylva_core::animate::zioma::{Zioma, ZiomaParams};
+use sylva_core::methods::Method;
+use sylva_core::methods::akagi::{Akagi, AkagiParams};
+use sylva_core::methods::hsm::{Hsm, HsmParams};
+use sylva_core::methods::skjermo::{Skjermo, SkjermoParams};
+use sylva_core::methods::zioma::{Zioma, ZiomaParams};
+use sylva_core::pose::Pose;
 use sylva_core::species::SpeciesSource;
-use sylva_core::wind::WindScene;
+use sylva_core::wind::{PackedWind, WindScene};
 
 const STEPS: usize = 600;
 const DT: f32 = 1.0 / 60.0;
@@ -33,62 +34,46 @@ fn hash_pose(h: &mut Sha256, pose: &Pose) {
     }
 }
 
+/// Steps `m` 600 times through the seam, hashing `extra(state)` (the state's arrays and
+/// time) and the pose every 100.
+fn run<M: Method>(m: &M, tree: &Tree, wind: &PackedWind, h: &mut Sha256, extra: impl Fn(&M::State, &mut Sha256)) {
+    let mut s = m.rest_state(tree);
+    for k in 1..=STEPS {
+        m.step(tree, wind, &mut s, DT);
+        if k % 100 == 0 {
+            extra(&s, h);
+            hash_pose(h, &m.pose(tree, wind, &s));
+        }
+    }
+}
+
 /// Runs `method` on `tree` and returns the digest of its states and poses every 100 steps.
-fn run(tree: &Tree, method: &str) -> String {
-    let (fields, waves) = WindScene::resolve("gusty").unwrap().pack();
+fn digest(tree: &Tree, method: &str) -> String {
+    let wind = WindScene::resolve("gusty").unwrap().packed();
     let mut h = Sha256::new();
     match method {
         "zioma" => {
             let m = Zioma::new(tree, ZiomaParams { seed: 5, ..Default::default() });
-            let mut t = 0.0f32;
-            for k in 1..=STEPS {
-                t += DT;
-                if k % 100 == 0 {
-                    h.update(bytemuck::cast_slice(&m.rotations_packed(tree, &fields, &waves, t)));
-                    hash_pose(&mut h, &m.pose_packed(tree, &fields, &waves, t));
-                }
-            }
+            run(&m, tree, &wind, &mut h, |s, h| {
+                h.update(bytemuck::cast_slice(&m.rotations_packed(tree, &wind.fields, &wind.waves, s.time)))
+            });
         }
-        "akagi" => {
-            let m = Akagi::new(tree, AkagiParams::default());
-            let mut s = m.rest_state(tree);
-            for k in 1..=STEPS {
-                m.step(tree, &fields, &waves, &mut s, DT);
-                if k % 100 == 0 {
-                    h.update(bytemuck::cast_slice(&s.theta));
-                    h.update(bytemuck::cast_slice(&s.omega));
-                    h.update(bytemuck::cast_slice(&s.acc));
-                    h.update(s.time.to_le_bytes());
-                    hash_pose(&mut h, &s.pose);
-                }
-            }
-        }
-        "skjermo" => {
-            let m = Skjermo::new(tree, SkjermoParams::default());
-            let mut s = m.rest_state(tree);
-            for k in 1..=STEPS {
-                m.step(tree, &fields, &waves, &mut s, DT);
-                if k % 100 == 0 {
-                    h.update(bytemuck::cast_slice(&s.stems));
-                    h.update(s.time.to_le_bytes());
-                    hash_pose(&mut h, &s.pose);
-                }
-            }
-        }
-        "hsm" => {
-            let m = Hsm::new(tree, HsmParams::default()).unwrap();
-            let mut s = m.rest_state();
-            for k in 1..=STEPS {
-                m.step(&fields, &waves, &mut s, DT);
-                if k % 100 == 0 {
-                    h.update(bytemuck::cast_slice(&s.displacement));
-                    h.update(bytemuck::cast_slice(&s.velocity));
-                    h.update(bytemuck::cast_slice(&s.clusters));
-                    h.update(s.time.to_le_bytes());
-                    hash_pose(&mut h, &m.pose(tree, &s));
-                }
-            }
-        }
+        "akagi" => run(&Akagi::new(tree, AkagiParams::default()), tree, &wind, &mut h, |s, h| {
+            h.update(bytemuck::cast_slice(&s.theta));
+            h.update(bytemuck::cast_slice(&s.omega));
+            h.update(bytemuck::cast_slice(&s.acc));
+            h.update(s.time.to_le_bytes());
+        }),
+        "skjermo" => run(&Skjermo::new(tree, SkjermoParams::default()), tree, &wind, &mut h, |s, h| {
+            h.update(bytemuck::cast_slice(&s.stems));
+            h.update(s.time.to_le_bytes());
+        }),
+        "hsm" => run(&Hsm::new(tree, HsmParams::default()).unwrap(), tree, &wind, &mut h, |s, h| {
+            h.update(bytemuck::cast_slice(&s.displacement));
+            h.update(bytemuck::cast_slice(&s.velocity));
+            h.update(bytemuck::cast_slice(&s.clusters));
+            h.update(s.time.to_le_bytes());
+        }),
         other => panic!("unknown method {other}"),
     }
     format!("{:x}", h.finalize())
@@ -101,17 +86,13 @@ fn cpu_simulations_match_their_pinned_digests_on_1_and_3_threads() {
     let mut checked = 0;
     for line in pinned.lines().filter(|l| !l.trim().is_empty() && !l.starts_with('#')) {
         let mut it = line.split_whitespace();
-        let (preset, seed, method, want) = (
-            it.next().unwrap(),
-            it.next().unwrap().parse::<u64>().unwrap(),
-            it.next().unwrap(),
-            it.next().unwrap(),
-        );
+        let (preset, seed, method, want) =
+            (it.next().unwrap(), it.next().unwrap().parse::<u64>().unwrap(), it.next().unwrap(), it.next().unwrap());
         let tree = SpeciesSource::resolve(preset).unwrap().generate(seed, &Default::default(), None).unwrap();
         let mut got = Vec::new();
         for threads in [1, 3] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            got.push(pool.install(|| run(&tree, method)));
+            got.push(pool.install(|| digest(&tree, method)));
         }
         assert_eq!(got[0], got[1], "{preset} {method}: the simulation depends on the thread count");
         if bless {

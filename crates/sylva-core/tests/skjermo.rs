@@ -2,8 +2,9 @@
 
 use glam::Vec3;
 use sylva_core::Tree;
-use sylva_core::animate::skjermo::{Skjermo, SkjermoParams};
-use sylva_core::animate::{Pose, displacement};
+use sylva_core::methods::Method;
+use sylva_core::methods::skjermo::{Skjermo, SkjermoParams};
+use sylva_core::pose::{Pose, displacement};
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::{Constant, WindField, WindScene};
 
@@ -21,9 +22,9 @@ fn still_air_keeps_the_exact_rest_pose_and_curves() {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
         let m = Skjermo::new(&t, SkjermoParams::default());
         let mut s = m.rest_state(&t);
-        let (f, w) = WindScene::default().pack();
+        let fw = WindScene::default().packed();
         for _ in 0..5 {
-            m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+            m.step(&t, &fw, &mut s, 1.0 / 60.0);
         }
         assert_eq!(s.pose.start, Pose::rest(&t).start, "{}", p.name);
         assert_eq!(s.pose.orientation, Pose::rest(&t).orientation, "{}", p.name);
@@ -37,7 +38,7 @@ fn still_air_keeps_the_exact_rest_pose_and_curves() {
 /// needed and counted right).
 #[test]
 fn the_rest_orientation_kernel_rebuilds_the_rest_orientations() {
-    use sylva_core::cpu::skjermo::{skjermo_rest_orient, stem_depth};
+    use sylva_core::methods::skjermo::kernels::{skjermo_rest_orient, stem_depth};
     for p in PRESETS {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
         let m = Skjermo::new(&t, SkjermoParams::default());
@@ -62,10 +63,10 @@ fn constant_wind_bends_downwind_more_as_it_rises() {
         let m = Skjermo::new(&t, SkjermoParams::default());
         let mut last = 0.0;
         for speed in [2.0, 5.0, 10.0, 20.0] {
-            let (f, w) = constant(speed).pack();
+            let fw = constant(speed).packed();
             let mut s = m.rest_state(&t);
             for _ in 0..30 {
-                m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+                m.step(&t, &fw, &mut s, 1.0 / 60.0);
             }
             let shift = displacement(&t, &s.pose).crown_mean;
             assert!(shift.x > last, "{name} {speed} m/s: {shift} after {last}");
@@ -97,12 +98,12 @@ fn each_level_lags_one_step_behind_its_parent() {
         }
     }
     m.rebuild_lanes();
-    let (f, w) = constant(12.0).pack();
+    let fw = constant(12.0).packed();
     let mut s = m.rest_state(&t);
     let levels = t.levels as usize;
     let mut first_move = vec![None; levels];
     for step in 1..=8u64 {
-        m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+        m.step(&t, &fw, &mut s, 1.0 / 60.0);
         let b = s.pose.bezier.as_ref().unwrap();
         for (k, bk) in b.iter().enumerate() {
             let l = t.stems.level[k] as usize;
@@ -123,11 +124,11 @@ fn a_100_000_step_storm_stays_sound_and_threads_do_not_matter() {
     if let WindField::Constant(c) = &mut wind.fields[0] {
         c.speed = 40.0;
     }
-    let (f, w) = wind.pack();
+    let fw = wind.packed();
     let m = Skjermo::new(&t, SkjermoParams::default());
     let mut s = m.rest_state(&t);
     for k in 0..100_000 {
-        m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+        m.step(&t, &fw, &mut s, 1.0 / 60.0);
         if k % 10_000 == 0 || k == 99_999 {
             if let Err(e) = s.pose.check_sound(&t) {
                 panic!("step {k}: {e}");
@@ -141,7 +142,7 @@ fn a_100_000_step_storm_stays_sound_and_threads_do_not_matter() {
         rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap().install(|| {
             let mut s = m.rest_state(&t);
             for _ in 0..40 {
-                m.step(&t, &f, &w, &mut s, 1.0 / 60.0);
+                m.step(&t, &fw, &mut s, 1.0 / 60.0);
             }
             s
         })
@@ -164,15 +165,15 @@ fn the_lane_path_matches_the_reference_kernel() {
     )
     .unwrap();
     for (wname, wind) in [("gusty", WindScene::resolve("gusty").unwrap()), ("sines", sines)] {
-        let (f, w) = wind.pack();
+        let fw = wind.packed();
         for p in PRESETS {
             let t = SpeciesSource::from_preset(p).unwrap().generate(3, &Default::default(), None).unwrap();
             let m = Skjermo::new(&t, SkjermoParams::default());
             let mut fast = m.rest_state(&t);
             let mut slow = m.rest_state(&t);
             for _ in 0..300 {
-                m.step(&t, &f, &w, &mut fast, 1.0 / 60.0);
-                m.step_reference(&f, &w, &mut slow, 1.0 / 60.0);
+                m.step(&t, &fw, &mut fast, 1.0 / 60.0);
+                m.step_reference(&fw.fields, &fw.waves, &mut slow, 1.0 / 60.0);
             }
             let tol = 1e-5 * t.height();
             let mut moved = 0.0f32;
@@ -194,7 +195,7 @@ fn the_lane_path_matches_the_reference_kernel() {
 /// a CPU without AVX2 only the baseline runs, and the test says so.
 #[test]
 fn every_instruction_set_level_gives_the_same_bits() {
-    use sylva_core::animate::skjermo_lanes::{StateLanes, step};
+    use sylva_core::methods::skjermo::lanes::{StateLanes, step};
     use sylva_core::simd::{Level, detected};
     if detected() == Level::Baseline {
         println!("this CPU has no AVX2: only the baseline level runs");
@@ -206,7 +207,7 @@ fn every_instruction_set_level_gives_the_same_bits() {
             .collect()
     };
     for wind in ["gusty", "blast"] {
-        let (f, w) = WindScene::resolve(wind).unwrap().pack();
+        let fw = WindScene::resolve(wind).unwrap().packed();
         for p in PRESETS {
             let t = SpeciesSource::from_preset(p).unwrap().generate(4, &Default::default(), None).unwrap();
             let m = Skjermo::new(&t, SkjermoParams::default());
@@ -214,7 +215,7 @@ fn every_instruction_set_level_gives_the_same_bits() {
                 let mut s = m.rest_state(&t).lanes;
                 let mut next = s.clone();
                 for k in 1..=200 {
-                    step(level, &f, &w, &m.lanes, &s, m.lane_step(k as f32 / 60.0), &mut next);
+                    step(level, &fw.fields, &fw.waves, &m.lanes, &s, m.lane_step(k as f32 / 60.0), &mut next);
                     std::mem::swap(&mut s, &mut next);
                 }
                 bits(&s)
@@ -231,12 +232,12 @@ fn every_instruction_set_level_gives_the_same_bits() {
 /// no out-of-bounds read, and the same bits as the same group with `NONE` parents.
 #[test]
 fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
-    use sylva_core::animate::skjermo_lanes::{StateLanes, step};
+    use sylva_core::methods::skjermo::lanes::{StateLanes, step};
     use sylva_core::model::NONE;
     use sylva_core::simd::{Level, detected};
     let t = tree("quaking_aspen");
     let m = Skjermo::new(&t, SkjermoParams::default());
-    let (f, w) = constant(12.0).pack();
+    let fw = constant(12.0).packed();
     let groups = m.lanes.len();
     let outside = [16 * groups as u32, 16 * groups as u32 + 15, u32::MAX - 1, 1 << 31];
     let mut edited = m.lanes.clone();
@@ -257,7 +258,7 @@ fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
         let mut s = m.rest_state(&t).lanes;
         let mut next = s.clone();
         for k in 1..=20 {
-            step(level, &f, &w, lanes, &s, m.lane_step(k as f32 / 60.0), &mut next);
+            step(level, &fw.fields, &fw.waves, lanes, &s, m.lane_step(k as f32 / 60.0), &mut next);
             std::mem::swap(&mut s, &mut next);
         }
         bits(&s)

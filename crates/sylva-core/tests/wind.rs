@@ -2,7 +2,7 @@
 //! promises, the turbulence spectrum, TOML round trips and errors.
 
 use glam::Vec3;
-use sylva_core::wind::trunk::TrunkNoise;
+use sylva_core::methods::zioma::trunk::TrunkNoise;
 use sylva_core::wind::*;
 
 fn one(f: WindField) -> WindScene {
@@ -182,10 +182,7 @@ fn spectral_slope(beta: f32) -> f64 {
     let p = Vec3::new(3.0, 10.0, -7.0);
     let mut buf: Vec<Complex<f64>> = (0..n)
         .map(|i| {
-            Complex::new(
-                sylva_core::cpu::wind_sample::wind_at(&fields, &waves, p, (i as f64 * dt) as f32).x as f64,
-                0.0,
-            )
+            Complex::new(sylva_core::wind::sample::wind_at(&fields, &waves, p, (i as f64 * dt) as f32).x as f64, 0.0)
         })
         .collect();
     FftPlanner::new().plan_fft_forward(n).process(&mut buf);
@@ -230,7 +227,7 @@ fn turbulence_has_the_requested_intensity_and_is_spatially_coherent() {
     };
     let scene = one(WindField::Turbulence(turb));
     let (f, w) = scene.pack();
-    let at = |p: Vec3, t: f32| sylva_core::cpu::wind_sample::wind_at(&f, &w, p, t);
+    let at = |p: Vec3, t: f32| sylva_core::wind::sample::wind_at(&f, &w, p, t);
     let n = 200_000;
     let rms = ((0..n).map(|i| at(Vec3::ZERO, i as f32 * 0.05).x.powi(2) as f64).sum::<f64>() / n as f64).sqrt();
     assert!((rms - 1.5).abs() < 0.2, "rms {rms}");

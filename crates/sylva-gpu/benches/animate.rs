@@ -7,12 +7,14 @@
 //! (Zioma's instancing, Skjermo's branch updates, …) are `sylva bench`.
 
 use std::time::{Duration, Instant};
-use sylva_core::animate::akagi::{Akagi, AkagiParams};
-use sylva_core::animate::zioma::{Zioma, ZiomaParams};
+use sylva_core::methods::Method;
+use sylva_core::methods::akagi::{Akagi, AkagiParams};
+use sylva_core::methods::zioma::{Zioma, ZiomaParams};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 use sylva_gpu::GpuContext;
-use sylva_gpu::pose::{GpuAkagi, GpuZioma};
+use sylva_gpu::methods::akagi::GpuAkagi;
+use sylva_gpu::methods::zioma::GpuZioma;
 
 fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
@@ -34,7 +36,7 @@ fn time(reps: usize, mut f: impl FnMut()) -> Duration {
 
 fn main() {
     let wind = WindScene::resolve("gusty").unwrap();
-    let (fields, waves) = wind.pack();
+    let fieldswaves = wind.packed();
     let ctx = GpuContext::shared().ok();
     if let Some(c) = ctx {
         println!("GPU: {}", c.summary);
@@ -53,10 +55,10 @@ fn main() {
         let mut tt = 0.0;
         let cpu = time(9, || {
             tt += 1.0 / 60.0;
-            std::hint::black_box(z.pose(&t, &wind, tt));
+            std::hint::black_box(z.pose_at(&t, &wind.packed(), tt));
         });
         let gpu = ctx.map(|c| {
-            let g = GpuZioma::new(c, &t, &z, &wind).unwrap();
+            let mut g = GpuZioma::new(c, &t, &z, &wind).unwrap();
             time(9, || {
                 tt += 1.0 / 60.0;
                 std::hint::black_box(g.pose(c, &t, &z, tt).unwrap());
@@ -68,7 +70,7 @@ fn main() {
         let mut s = a.rest_state(&t);
         let cpu = time(3, || {
             for _ in 0..60 {
-                a.step(&t, &fields, &waves, &mut s, 1.0 / 60.0);
+                a.step(&t, &fieldswaves, &mut s, 1.0 / 60.0);
             }
         });
         let gpu = ctx.map(|c| {
@@ -99,7 +101,7 @@ fn fk_table(ctx: Option<&'static GpuContext>) {
     for name in ["quaking_aspen", "black_tupelo", "weeping_willow", "sympodial"] {
         let t = SpeciesSource::resolve(name).unwrap().generate(1, &Default::default(), None).unwrap();
         let n = t.segments.len();
-        let depth = sylva_core::cpu::pose_fk::depth_buckets(&t.segments.parent).len();
+        let depth = sylva_core::pose::fk::depth_buckets(&t.segments.parent).len();
         let delta = vec![[0.0f32, 0.0, 0.0, 1.0]; n];
         let rate = |strategy| {
             let p = GpuPose::with_strategy(c, &t, strategy).unwrap();

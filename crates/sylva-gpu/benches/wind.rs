@@ -8,9 +8,10 @@
 
 use criterion::{Criterion, Throughput, criterion_group};
 use std::time::{Duration, Instant};
+use sylva_core::methods::Method;
 use sylva_core::wind::WindScene;
 use sylva_gpu::GpuContext;
-use sylva_gpu::wind_sample::WindSampler;
+use sylva_gpu::wind::WindSampler;
 
 const N: usize = 1 << 20;
 
@@ -31,18 +32,18 @@ fn cpu_once(
     out: &mut [[f32; 4]],
 ) -> Duration {
     let t = Instant::now();
-    sylva_core::cpu::wind_sample(fields, waves, s, out);
+    sylva_core::wind::sample::wind_sample(fields, waves, s, out);
     t.elapsed()
 }
 
 fn benches(c: &mut Criterion) {
     let s = samples();
-    let (fields, waves) = scene().pack();
+    let fieldswaves = scene().packed();
     let mut out = vec![[0.0f32; 4]; N];
     let mut g = c.benchmark_group("wind_samples");
     g.throughput(Throughput::Elements(N as u64)).sample_size(10);
     g.bench_function("cpu", |b| {
-        b.iter_custom(|iters| (0..iters).map(|_| cpu_once(&fields, &waves, &s, &mut out)).sum())
+        b.iter_custom(|iters| (0..iters).map(|_| cpu_once(&fieldswaves.fields, &fieldswaves.waves, &s, &mut out)).sum())
     });
     match GpuContext::shared() {
         Ok(ctx) => {
@@ -65,10 +66,10 @@ fn median(mut v: Vec<Duration>) -> (Duration, Duration, Duration) {
 /// CPU and GPU in one run, so the ratio compares like with like.
 fn summary() {
     let s = samples();
-    let (fields, waves) = scene().pack();
+    let fieldswaves = scene().packed();
     let mut out = vec![[0.0f32; 4]; N];
-    cpu_once(&fields, &waves, &s, &mut out);
-    let (cpu, cpu_lo, cpu_hi) = median((0..7).map(|_| cpu_once(&fields, &waves, &s, &mut out)).collect());
+    cpu_once(&fieldswaves.fields, &fieldswaves.waves, &s, &mut out);
+    let (cpu, cpu_lo, cpu_hi) = median((0..7).map(|_| cpu_once(&fieldswaves.fields, &fieldswaves.waves, &s, &mut out)).collect());
     let rate = |d: Duration| N as f64 / d.as_secs_f64() / 1e6;
     println!("\nwind samples, {N} per run, `gusty` scene, {} CPU threads", rayon::current_num_threads());
     println!(

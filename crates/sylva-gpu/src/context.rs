@@ -1,6 +1,6 @@
 //! The GPU context: instance, adapter, device and queue.
 
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// Errors setting up or using the GPU.
 #[derive(Debug, thiserror::Error)]
@@ -55,8 +55,9 @@ impl std::fmt::Display for AdapterSummary {
 /// A device and its queue, with the adapter it came from.
 #[derive(Debug)]
 pub struct GpuContext {
-    /// The instance (a window's surface must come from it).
-    pub instance: wgpu::Instance,
+    /// The instance (a window's surface must come from it); `None` for a device an
+    /// application handed over without its instance.
+    pub instance: Option<wgpu::Instance>,
     /// The adapter.
     pub adapter: wgpu::Adapter,
     /// The device.
@@ -111,14 +112,44 @@ impl GpuContext {
             trace: wgpu::Trace::Off,
         }))
         .map_err(|e| GpuError::Device { adapter: summary.name.clone(), message: e.to_string() })?;
-        Ok(Self { instance, adapter, device, queue, summary, timestamps, kernels: Default::default() })
+        Ok(Self { instance: Some(instance), adapter, device, queue, summary, timestamps, kernels: Default::default() })
+    }
+
+    /// A context on an application's own device, so an engine and Sylva share it. Kernels
+    /// respect the device's limits (a large tree may need the adapter's, not wgpu's
+    /// defaults: a buffer beyond them is refused with [`GpuError::TooLarge`]); timestamp
+    /// queries are used when the device was created with them.
+    pub fn from_wgpu(
+        instance: Option<wgpu::Instance>,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Self {
+        let info = adapter.get_info();
+        let summary = AdapterSummary {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
+        };
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        Self { instance, adapter, device, queue, summary, timestamps, kernels: Default::default() }
     }
 
     /// One context shared by the whole process (tests, benchmarks, the CLI): created on
     /// first use, reused after.
     pub fn shared() -> Result<&'static GpuContext, GpuError> {
-        static SHARED: OnceLock<Result<GpuContext, String>> = OnceLock::new();
-        match SHARED.get_or_init(|| GpuContext::new(&GpuOptions::default()).map_err(|e| e.to_string())) {
+        Ok(Self::shared_slot()?)
+    }
+
+    /// [`Self::shared`] as a handle others can keep ([`Arc`]).
+    pub fn shared_arc() -> Result<Arc<GpuContext>, GpuError> {
+        Ok(Self::shared_slot()?.clone())
+    }
+
+    fn shared_slot() -> Result<&'static Arc<GpuContext>, GpuError> {
+        static SHARED: OnceLock<Result<Arc<GpuContext>, String>> = OnceLock::new();
+        match SHARED.get_or_init(|| GpuContext::new(&GpuOptions::default()).map(Arc::new).map_err(|e| e.to_string())) {
             Ok(c) => Ok(c),
             Err(e) => Err(GpuError::NoAdapter(e.clone())),
         }

@@ -1,5 +1,5 @@
 //! A small, uniform way to run a compute kernel: build the pipeline from composed WGSL
-//! ([`crate::shader::compose`]), upload structure-of-arrays buffers, dispatch over any
+//! ([`crate::shaders::compose`]), upload structure-of-arrays buffers, dispatch over any
 //! number of invocations, and read back.
 //!
 //! Kernels index their work item as `gid.x + gid.y * num_workgroups.x * WORKGROUP`, so a
@@ -43,7 +43,7 @@ impl Kernel {
     pub fn new(ctx: &GpuContext, name: &'static str, sources: &[&str]) -> Self {
         let module = ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(name),
-            source: wgpu::ShaderSource::Wgsl(crate::shader::compose(sources).into()),
+            source: wgpu::ShaderSource::Wgsl(crate::shaders::compose(sources).into()),
         });
         let pipeline = ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(name),
@@ -57,11 +57,20 @@ impl Kernel {
         Self { name, pipeline, layout, max_groups_x: None }
     }
 
-    /// The kernel `name`, compiled on first use and shared after (shader compilation is the
-    /// slow part of setting a kernel up, seconds on a software rasteriser).
+    /// The kernel `name` composed from `sources`, compiled on first use and shared after
+    /// (shader compilation is the slow part of setting a kernel up, seconds on a software
+    /// rasteriser). Sylva's own kernels come by [`Self::get`]; this is for kernels of
+    /// methods defined outside the crate, under names of their own.
     pub fn cached(ctx: &GpuContext, name: &'static str, sources: &[&str]) -> std::sync::Arc<Self> {
         let mut map = ctx.kernels.lock().unwrap_or_else(|e| e.into_inner());
         map.entry(name).or_insert_with(|| std::sync::Arc::new(Self::new(ctx, name, sources))).clone()
+    }
+
+    /// The registered kernel `name` ([`crate::shaders::KERNELS`]), compiled on first use and
+    /// shared after. Panics when no kernel has that name (names are constants of the crate).
+    pub fn get(ctx: &GpuContext, name: &str) -> std::sync::Arc<Self> {
+        let def = crate::shaders::kernel(name).unwrap_or_else(|| panic!("no kernel `{name}` in shaders::KERNELS"));
+        Self::cached(ctx, def.name, def.sources)
     }
 
     /// Caps the workgroups in `x` below the device limit, so tests can exercise the spill

@@ -2,11 +2,15 @@
 
 mod common;
 
-use sylva_core::animate::Pose;
-use sylva_core::animate::akagi::{Akagi, AkagiParams};
+use std::sync::Arc;
+use sylva_core::methods::Method;
+use sylva_core::methods::akagi::{Akagi, AkagiParams};
+use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
-use sylva_gpu::pose::GpuAkagi;
+use sylva_gpu::methods::GpuAnimator;
+use sylva_gpu::wind::GpuWind;
+use sylva_gpu::methods::akagi::GpuAkagi;
 
 /// Joint positions within 1e-4 × tree height after 1,000 steps at 60 Hz in gusty wind: both
 /// sides run the same f32 operations in the same order (children summed in index order).
@@ -14,17 +18,17 @@ use sylva_gpu::pose::GpuAkagi;
 fn akagi_matches_after_1000_steps_on_every_preset() {
     let Some(ctx) = common::gpu() else { return };
     let wind = WindScene::resolve("gusty").unwrap();
-    let (f, w) = wind.pack();
+    let fw = wind.packed();
     for p in PRESETS {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
         let a = Akagi::new(&t, AkagiParams::default());
         let mut cpu = a.rest_state(&t);
-        let mut gpu = GpuAkagi::new(ctx, &t, &a, &wind).unwrap();
+        let mut gpu = GpuAkagi::new(ctx, Arc::new(t.clone()), &a, &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
         for _ in 0..1000 {
-            a.step(&t, &f, &w, &mut cpu, 1.0 / 60.0);
+            a.step(&t, &fw, &mut cpu, 1.0 / 60.0);
             gpu.step(ctx, 1.0 / 60.0);
         }
-        let g = gpu.read(ctx).unwrap();
+        let g = gpu.read_pose(ctx).unwrap();
         let height = t.height();
         let mut worst = 0.0f32;
         for i in 0..t.segments.len() {
@@ -42,9 +46,9 @@ fn akagi_on_the_gpu_stays_at_rest_in_still_air() {
     let Some(ctx) = common::gpu() else { return };
     let t = SpeciesSource::resolve("monopodial").unwrap().generate(1, &Default::default(), None).unwrap();
     let a = Akagi::new(&t, AkagiParams::default());
-    let mut g = GpuAkagi::new(ctx, &t, &a, &WindScene::default()).unwrap();
+    let mut g = GpuAkagi::new(ctx, Arc::new(t.clone()), &a, &GpuWind::calm(ctx).unwrap()).unwrap();
     for _ in 0..50 {
         g.step(ctx, 1.0 / 60.0);
     }
-    assert_eq!(g.read(ctx).unwrap(), Pose::rest(&t));
+    assert_eq!(g.read_pose(ctx).unwrap(), Pose::rest(&t));
 }

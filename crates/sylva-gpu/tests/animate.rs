@@ -2,14 +2,17 @@
 
 mod common;
 
+use std::sync::Arc;
 use glam::{Quat, Vec3};
 use rand::{Rng, SeedableRng};
 use sylva_core::Tree;
-use sylva_core::animate::Pose;
-use sylva_core::animate::zioma::{Zioma, ZiomaParams};
+use sylva_core::methods::zioma::{Zioma, ZiomaParams};
+use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
-use sylva_gpu::pose::{FkStrategy, GpuPose, GpuZioma};
+use sylva_gpu::wind::GpuWind;
+use sylva_gpu::pose::{FkStrategy, GpuPose};
+use sylva_gpu::methods::zioma::GpuZioma;
 
 /// The angle between two nearby unit quaternions: |q₁ − q₂| ≈ half of it (acos near 1
 /// cannot resolve 1e-4 rad in f32).
@@ -47,9 +50,9 @@ fn compare(t: &Tree, cpu: &Pose, gpu: &Pose, what: &str) -> f32 {
 /// H100: twigs 1.8e-4 rad apart at t = 118 s, over the plain 1e-4 rad bound; lavapipe,
 /// which does not fuse, stays under 1e-5.
 fn time_rounding_allowance(z: &Zioma, t: &Tree, wind: &WindScene, time: f32) -> Vec<f32> {
-    let at = z.pose(t, wind, time);
+    let at = z.pose_at(t, &wind.packed(), time);
     let dt = 2.0 * time.abs() * 2f32.powi(-23);
-    let (early, late) = (z.pose(t, wind, time - dt), z.pose(t, wind, time + dt));
+    let (early, late) = (z.pose_at(t, &wind.packed(), time - dt), z.pose_at(t, &wind.packed(), time + dt));
     (0..t.segments.len())
         .map(|i| angle(at.orientation[i], early.orientation[i]).max(angle(at.orientation[i], late.orientation[i])))
         .collect()
@@ -81,16 +84,8 @@ fn forward_kinematics_matches_on_random_rotations() {
         let n = t.segments.len();
         let rest: Vec<[f32; 4]> = t.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
         let (mut acc, mut disp, mut joints) = (vec![[0.0f32; 4]; n], vec![[0.0f32; 4]; n], vec![[0.0f32; 4]; n]);
-        for b in sylva_core::cpu::pose_fk::depth_buckets(&t.segments.parent) {
-            sylva_core::cpu::pose_fk::pose_level(
-                &b,
-                &t.segments.parent,
-                &rest,
-                &delta,
-                &mut acc,
-                &mut disp,
-                &mut joints,
-            );
+        for b in sylva_core::pose::fk::depth_buckets(&t.segments.parent) {
+            sylva_core::pose::fk::pose_level(&b, &t.segments.parent, &rest, &delta, &mut acc, &mut disp, &mut joints);
         }
         let twin = Pose {
             start: joints.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect(),
@@ -116,12 +111,12 @@ fn zioma_matches_on_every_preset_at_random_times() {
     for p in PRESETS {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
         let z = Zioma::new(&t, ZiomaParams::default());
-        let gpu = GpuZioma::new(ctx, &t, &z, &wind).unwrap();
+        let mut gpu = GpuZioma::new(ctx, Arc::new(t.clone()), z.clone(), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
         let mut worst = 0.0f32;
         for _ in 0..3 {
             let time = rng.random_range(0.0..120.0);
-            let a = z.pose(&t, &wind, time);
-            let b = gpu.pose(ctx, &t, &z, time).unwrap();
+            let a = z.pose_at(&t, &wind.packed(), time);
+            let b = gpu.pose(ctx, time).unwrap();
             let allowance = time_rounding_allowance(&z, &t, &wind, time);
             worst = worst.max(compare_within(&t, &a, &b, Some(&allowance), p.name));
         }
@@ -134,8 +129,8 @@ fn zioma_on_the_gpu_is_at_rest_in_still_air() {
     let Some(ctx) = common::gpu() else { return };
     let t = SpeciesSource::resolve("quaking_aspen").unwrap().generate(1, &Default::default(), None).unwrap();
     let z = Zioma::new(&t, ZiomaParams::default());
-    let gpu = GpuZioma::new(ctx, &t, &z, &WindScene::default()).unwrap();
-    assert_eq!(gpu.pose(ctx, &t, &z, 5.0).unwrap(), Pose::rest(&t));
+    let mut gpu = GpuZioma::new(ctx, Arc::new(t.clone()), z.clone(), &GpuWind::calm(ctx).unwrap()).unwrap();
+    assert_eq!(gpu.pose(ctx, 5.0).unwrap(), Pose::rest(&t));
 }
 
 /// Instancing (§6.5): many placed, turned, phase-shifted copies of one tree in one dispatch.
@@ -143,26 +138,26 @@ fn zioma_on_the_gpu_is_at_rest_in_still_air() {
 /// phase or seed reproduces the single tree exactly; instances at different places differ.
 #[test]
 fn zioma_instances_match_and_sway_independently() {
-    use sylva_core::animate::zioma::ZiomaInstance;
+    use sylva_core::methods::zioma::ZiomaInstance;
     let Some(ctx) = common::gpu() else { return };
     let wind = WindScene::resolve("gusty").unwrap();
-    let (f, w) = wind.pack();
+    let fw = wind.packed();
     let t = SpeciesSource::resolve("stochastic_bush").unwrap().generate(4, &Default::default(), None).unwrap();
     let z = Zioma::new(&t, ZiomaParams::default());
     let mut instances = ZiomaInstance::grid(37, 6.0, 9);
     instances[0] = ZiomaInstance::default();
-    let gpu = GpuZioma::with_instances(ctx, &t, &z, &wind, &instances).unwrap();
+    let mut gpu = GpuZioma::with_instances(ctx, Arc::new(t.clone()), z.clone(), &GpuWind::from_scene(ctx, &wind).unwrap(), &instances).unwrap();
     let mut rng = rand::rngs::StdRng::seed_from_u64(13);
     for _ in 0..3 {
         let time = rng.random_range(0.0..60.0);
-        let cpu = Pose::from_rotations_instances(&t, &z.rotations_instances(&t, &f, &w, time, &instances));
-        let got = gpu.poses(ctx, &t, &z, time).unwrap();
+        let cpu = Pose::from_rotations_instances(&t, &z.rotations_instances(&t, &fw.fields, &fw.waves, time, &instances));
+        let got = gpu.poses(ctx, time).unwrap();
         assert_eq!(cpu.len(), instances.len());
         assert_eq!(got.len(), instances.len());
         for (k, (a, b)) in cpu.iter().zip(&got).enumerate() {
             compare(&t, a, b, &format!("instance {k} at {time} s"));
         }
-        assert_eq!(cpu[0], z.pose(&t, &wind, time), "an instance at the origin is the single tree");
+        assert_eq!(cpu[0], z.pose_at(&t, &wind.packed(), time), "an instance at the origin is the single tree");
         let distinct = cpu.windows(2).filter(|p| p[0].start != p[1].start).count();
         assert!(distinct >= instances.len() - 2, "instances sway alike: {distinct} differ");
     }

@@ -3,14 +3,17 @@
 
 mod common;
 
+use std::sync::Arc;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
+use sylva_core::methods::Method;
 use sylva_core::Tree;
-use sylva_core::animate::Pose;
-use sylva_core::animate::hsm::{Hsm, HsmLayout, HsmParams, HsmState};
+use sylva_core::methods::hsm::{Hsm, HsmLayout, HsmParams, HsmState};
+use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
-use sylva_core::wind::WindScene;
-use sylva_gpu::hsm::GpuHsm;
+use sylva_core::wind::{PackedWind, WindScene};
+use sylva_gpu::wind::GpuWind;
+use sylva_gpu::methods::hsm::GpuHsm;
 
 fn tree(name: &str) -> Tree {
     SpeciesSource::resolve(name).unwrap().generate(1, &Default::default(), None).unwrap()
@@ -31,7 +34,7 @@ fn worst(a: &HsmState, b: &HsmState) -> f32 {
 fn hsm_one_substep_matches_from_random_states() {
     let Some(ctx) = common::gpu() else { return };
     let wind = WindScene::resolve("gusty").unwrap();
-    let (f, w) = wind.pack();
+    let fw = wind.packed();
     let mut rng = rand::rngs::StdRng::seed_from_u64(0x45_4d);
     for (name, beta, fused) in
         [("quaking_aspen", 0.0, false), ("ca_black_oak", 0.3, false), ("stochastic_bush", 0.0, true)]
@@ -39,7 +42,7 @@ fn hsm_one_substep_matches_from_random_states() {
         let t = tree(name);
         let params = HsmParams { substeps: 1, beta, fused, ..Default::default() };
         let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(3000)).unwrap());
-        let mut state = h.rest_state();
+        let mut state = h.state_at_rest();
         for (p, v) in state.displacement.iter_mut().zip(state.velocity.iter_mut()) {
             for k in 0..3 {
                 p[k] += rng.random_range(-0.005..0.005);
@@ -51,11 +54,11 @@ fn hsm_one_substep_matches_from_random_states() {
             c.rotation = glam::Quat::from_axis_angle(axis, rng.random_range(-0.5..0.5)).to_array();
         }
         state.time = rng.random_range(0.0..100.0);
-        let mut gpu = GpuHsm::new(ctx, Some(&t), &h, &wind).unwrap();
+        let mut gpu = GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
         gpu.write_state(ctx, &state);
         let mut cpu = state.clone();
-        h.step(&f, &w, &mut cpu, 1.0 / 240.0);
-        gpu.step(ctx, &h, 1.0 / 240.0);
+        h.step_packed(&fw.fields, &fw.waves, &mut cpu, 1.0 / 240.0);
+        gpu.step(ctx, 1.0 / 240.0);
         let g = gpu.read_state(ctx).unwrap();
         let tol = 1e-5 * t.height();
         let d = worst(&cpu, &g);
@@ -87,25 +90,25 @@ fn hsm_one_substep_matches_from_random_states() {
 fn hsm_matches_after_1000_steps_on_every_preset() {
     let Some(ctx) = common::gpu() else { return };
     let wind = WindScene::resolve("gusty").unwrap();
-    let (f, w) = wind.pack();
+    let fw = wind.packed();
     for p in PRESETS {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
         let params = HsmParams { substeps: 1, ..Default::default() };
         let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(150)).unwrap());
-        let mut cpu = h.rest_state();
-        let mut gpu = GpuHsm::new(ctx, Some(&t), &h, &wind).unwrap();
+        let mut cpu = h.state_at_rest();
+        let mut gpu = GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
         for _ in 0..1000 {
-            h.step(&f, &w, &mut cpu, 1.0 / 240.0);
+            h.step_packed(&fw.fields, &fw.waves, &mut cpu, 1.0 / 240.0);
         }
-        gpu.advance(ctx, &h, 1.0 / 240.0, 1000);
+        gpu.advance_steps(ctx, 1.0 / 240.0, 1000);
         let g = gpu.read_state(ctx).unwrap();
         let height = t.height();
         let d = worst(&cpu, &g);
         assert!(d <= 1e-4 * height, "{}: particles differ by {d} m (tolerance {})", p.name, 1e-4 * height);
-        let moved = cpu.max_distance(&h.rest_state());
+        let moved = cpu.max_distance(&h.state_at_rest());
         assert!(moved > 1e-4 * height, "{}: moved {moved} m, less than the tolerance", p.name);
         let pose = gpu.read_pose(ctx).unwrap().unwrap();
-        let cpu_pose = h.pose(&t, &cpu);
+        let cpu_pose = h.pose(&t, &PackedWind::calm(), &cpu);
         for (i, (a, b)) in cpu_pose.start.iter().zip(&pose.start).enumerate() {
             assert!((*a - *b).length() <= 1e-4 * height, "{}: joint {i} {a} vs {b}", p.name);
         }
@@ -118,20 +121,20 @@ fn hsm_matches_after_1000_steps_on_every_preset() {
 fn hsm_whole_trees_match_on_the_gpu() {
     let Some(ctx) = common::gpu() else { return };
     let wind = WindScene::resolve("gusty").unwrap();
-    let (f, w) = wind.pack();
+    let fw = wind.packed();
     for name in ["quaking_aspen", "stochastic_bush", "palm"] {
         let t = tree(name);
         let h = Hsm::new(&t, HsmParams::default()).unwrap();
-        let mut cpu = h.rest_state();
-        let mut gpu = GpuHsm::new(ctx, Some(&t), &h, &wind).unwrap();
+        let mut cpu = h.state_at_rest();
+        let mut gpu = GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
         for _ in 0..30 {
-            h.step(&f, &w, &mut cpu, 1.0 / 60.0);
-            gpu.step(ctx, &h, 1.0 / 60.0);
+            h.step_packed(&fw.fields, &fw.waves, &mut cpu, 1.0 / 60.0);
+            gpu.step(ctx, 1.0 / 60.0);
         }
         let g = gpu.read_state(ctx).unwrap();
         let d = worst(&cpu, &g);
         assert!(d <= 1e-4 * t.height(), "{name}: particles differ by {d} m");
-        assert!(cpu.max_distance(&h.rest_state()) > 0.0, "{name}: nothing moved");
+        assert!(cpu.max_distance(&h.state_at_rest()) > 0.0, "{name}: nothing moved");
     }
 }
 
@@ -141,10 +144,10 @@ fn hsm_on_the_gpu_stays_at_rest_in_still_air() {
     let Some(ctx) = common::gpu() else { return };
     let t = tree("stochastic_bush");
     let h = Hsm::new(&t, HsmParams::default()).unwrap();
-    let mut gpu = GpuHsm::new(ctx, Some(&t), &h, &WindScene::default()).unwrap();
+    let mut gpu = GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::calm(ctx).unwrap()).unwrap();
     assert_eq!(gpu.read_pose(ctx).unwrap().unwrap(), Pose::rest(&t));
-    gpu.advance(ctx, &h, 1.0 / 60.0, 20);
+    gpu.advance_steps(ctx, 1.0 / 60.0, 20);
     let g = gpu.read_state(ctx).unwrap();
-    assert_eq!(g.displacement, h.rest_state().displacement);
+    assert_eq!(g.displacement, h.state_at_rest().displacement);
     assert_eq!(gpu.read_pose(ctx).unwrap().unwrap(), Pose::rest(&t));
 }

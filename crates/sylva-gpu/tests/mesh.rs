@@ -3,16 +3,20 @@
 
 mod common;
 
+use std::sync::Arc;
 use glam::{Quat, Vec3};
 use rand::{Rng, SeedableRng};
+use sylva_core::methods::Method;
 use sylva_core::Tree;
-use sylva_core::animate::Pose;
-use sylva_core::animate::zioma::{Zioma, ZiomaParams};
 use sylva_core::mesh::{MeshFrame, MeshLayout, MeshParams};
+use sylva_core::methods::zioma::{Zioma, ZiomaParams};
+use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
+use sylva_gpu::methods::GpuAnimator;
+use sylva_gpu::wind::GpuWind;
 use sylva_gpu::mesh::GpuMesh;
-use sylva_gpu::pose::GpuZioma;
+use sylva_gpu::methods::zioma::GpuZioma;
 
 fn random_pose(t: &Tree, rng: &mut rand::rngs::StdRng) -> Pose {
     let delta: Vec<[f32; 4]> = (0..t.segments.len())
@@ -72,16 +76,16 @@ fn gpu_mesh_reads_a_gpu_methods_pose_without_a_round_trip() {
     let t = SpeciesSource::resolve("sassafras").unwrap().generate(4, &Default::default(), None).unwrap();
     let wind = WindScene::resolve("gusty").unwrap();
     let method = Zioma::new(&t, ZiomaParams::default());
-    let g = GpuZioma::new(ctx, &t, &method, &wind).unwrap();
+    let mut g = GpuZioma::new(ctx, Arc::new(t.clone()), method.clone(), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
     let layout = MeshLayout::new(&t, MeshParams::default()).unwrap();
     let mesh = GpuMesh::new(ctx, &layout).unwrap();
     for time in [0.7f32, 3.1] {
-        g.submit(ctx, &t, &method, time);
+        g.submit(ctx, time);
         let mut e = ctx.device.create_command_encoder(&Default::default());
-        mesh.record(ctx, &mut e, g.gpu_pose().joints_buffer(), g.gpu_pose().acc_buffer());
+        mesh.record(ctx, &mut e, g.pose_buffers().joints_buffer(), g.pose_buffers().acc_buffer());
         ctx.queue.submit([e.finish()]);
         let on_gpu = mesh.read(ctx).unwrap();
-        let pose = g.gpu_pose().read(ctx).unwrap();
+        let pose = g.pose_buffers().read(ctx).unwrap();
         let worst = compare(&t, &layout.mesh(&t, &pose), &on_gpu, &format!("zioma t = {time}"));
         println!("zioma t = {time}: worst {worst:.1e} × height");
         // The wind moved it: not the rest mesh.
@@ -93,7 +97,7 @@ fn gpu_mesh_reads_a_gpu_methods_pose_without_a_round_trip() {
 #[test]
 fn gpu_skinning_matches_cpu_for_many_instances() {
     use sylva_core::mesh::SkinLayout;
-    use sylva_gpu::skin::GpuSkin;
+    use sylva_gpu::mesh::skin::GpuSkin;
     let Some(ctx) = common::gpu() else { return };
     let mut rng = rand::rngs::StdRng::seed_from_u64(77);
     let t = SpeciesSource::resolve("quaking_aspen").unwrap().generate(1, &Default::default(), None).unwrap();
@@ -102,7 +106,7 @@ fn gpu_skinning_matches_cpu_for_many_instances() {
     let instances = 5u32;
     let (mut joint, mut acc) = (Vec::new(), Vec::new());
     for _ in 0..instances {
-        let (j, a) = sylva_core::mesh::pose_buffers(&t, &random_pose(&t, &mut rng));
+        let (j, a) = sylva_core::pose::pose_buffers(&t, &random_pose(&t, &mut rng));
         joint.extend(j);
         acc.extend(a);
     }
@@ -128,13 +132,13 @@ fn gpu_skinning_matches_cpu_for_many_instances() {
 /// (CPU Skjermo steps), with random grid resolutions.
 #[test]
 fn gpu_deformer_matches_cpu_on_every_preset() {
-    use sylva_core::animate::skjermo::{Skjermo, SkjermoParams};
     use sylva_core::mesh::{DeformLayout, DeformerParams, RawVertex};
-    use sylva_gpu::deform::GpuDeform;
+    use sylva_core::methods::skjermo::{Skjermo, SkjermoParams};
+    use sylva_gpu::mesh::deform::GpuDeform;
     let Some(ctx) = common::gpu() else { return };
     let mut rng = rand::rngs::StdRng::seed_from_u64(31);
     let wind = WindScene::resolve("gusty").unwrap();
-    let (fields, waves) = wind.pack();
+    let fieldswaves = wind.packed();
     for preset in PRESETS {
         let t = SpeciesSource::resolve(preset.name).unwrap().generate(2, &Default::default(), None).unwrap();
         let params = DeformerParams {
@@ -148,10 +152,10 @@ fn gpu_deformer_matches_cpu_on_every_preset() {
         let m = Skjermo::new(&t, SkjermoParams::default());
         let mut state = m.rest_state(&t);
         for _ in 0..rng.random_range(10..40) {
-            m.step(&t, &fields, &waves, &mut state, 1.0 / 30.0);
+            m.step(&t, &fieldswaves, &mut state, 1.0 / 30.0);
         }
         let mut cpu = vec![bytemuck::Zeroable::zeroed(); layout.vertex_count()];
-        sylva_core::cpu::skjermo_deform(
+        sylva_core::mesh::skjermo_deform(
             &layout.info(),
             &layout.rings,
             &layout.shapes,

@@ -13,13 +13,13 @@ const ENDS_REL_TOL: f32 = 2e-6;
 
 fn compare(segments: &[RawSegment], max_groups_x: Option<u32>) -> f32 {
     let ctx = common::gpu().expect("checked by caller");
-    let mut kernel = sylva_gpu::segment_ends::kernel(ctx);
+    let mut kernel = sylva_gpu::pose::segment_ends::kernel(ctx);
     if let Some(m) = max_groups_x {
         kernel = kernel.with_max_groups_x(m);
     }
-    let gpu = sylva_gpu::segment_ends::segment_ends_with(ctx, kernel, segments).unwrap();
+    let gpu = sylva_gpu::pose::segment_ends::segment_ends_with(ctx, kernel, segments).unwrap();
     let mut cpu = vec![[0.0f32; 4]; segments.len()];
-    sylva_core::cpu::segment_ends(segments, &mut cpu);
+    sylva_core::pose::segment_ends::segment_ends(segments, &mut cpu);
     let mut worst: f32 = 0.0;
     for (i, s) in segments.iter().enumerate() {
         let scale = Vec3::from_array(s.start).length() + s.length + 1e-3;
@@ -67,7 +67,7 @@ fn segment_ends_match_on_a_generated_tree() {
     compare(&tree.raw_segments(), None);
     // And the GPU ends are the model's own ends.
     let ctx = common::gpu().unwrap();
-    let gpu = sylva_gpu::segment_ends::segment_ends(ctx, &tree.raw_segments()).unwrap();
+    let gpu = sylva_gpu::pose::segment_ends::segment_ends(ctx, &tree.raw_segments()).unwrap();
     for i in (0..tree.segments.len()).step_by(31) {
         assert!((Vec3::from_slice(&gpu[i][..3]) - tree.segments.end(i)).length() < 1e-4);
     }
@@ -90,6 +90,6 @@ fn oversized_input_is_a_clear_error() {
         return; // A device with a huge binding limit: nothing to provoke cheaply.
     }
     let segments = vec![RawSegment { orientation: [0.0, 0.0, 0.0, 1.0], ..bytemuck::Zeroable::zeroed() }; n];
-    let e = sylva_gpu::segment_ends::segment_ends(ctx, &segments).unwrap_err().to_string();
+    let e = sylva_gpu::pose::segment_ends::segment_ends(ctx, &segments).unwrap_err().to_string();
     assert!(e.contains("segments") && e.contains("limit"), "{e}");
 }

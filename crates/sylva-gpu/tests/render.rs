@@ -11,8 +11,8 @@ mod common;
 
 use glam::{Mat4, Vec3};
 use std::path::PathBuf;
-use sylva_core::animate::Pose;
 use sylva_core::mesh::{MeshLayout, MeshParams};
+use sylva_core::pose::Pose;
 use sylva_core::species::SpeciesSource;
 use sylva_gpu::mesh::GpuMesh;
 use sylva_gpu::render::{Camera, Instance, Lighting, RENDER_WGSL, RawGlobals, RenderSettings, Renderer};
@@ -114,7 +114,7 @@ fn small_scene_matches_its_golden_image() {
 #[test]
 fn skinned_instances_drawn_in_batches_match_one_batch() {
     use sylva_core::mesh::SkinLayout;
-    use sylva_gpu::skin::GpuSkin;
+    use sylva_gpu::mesh::skin::GpuSkin;
     let Some(ctx) = common::gpu() else { return };
     let t = SpeciesSource::resolve("palm").unwrap().generate(1, &Default::default(), None).unwrap();
     let layout = MeshLayout::new(&t, MeshParams { sides: 6, leaf_sides: 6, ..Default::default() }).unwrap();
@@ -136,7 +136,7 @@ fn skinned_instances_drawn_in_batches_match_one_batch() {
         let delta: Vec<[f32; 4]> = (0..t.segments.len())
             .map(|s| if t.segments.parent[s] == sylva_core::NONE { bend.to_array() } else { [0.0, 0.0, 0.0, 1.0] })
             .collect();
-        let (j, a) = sylva_core::animate::seam_buffers(&t, &delta);
+        let (j, a) = sylva_core::pose::seam_buffers(&t, &delta);
         joint.extend(j);
         acc.extend(a);
     }

@@ -4,7 +4,7 @@
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::mem::{offset_of, size_of};
 use sylva_core::model::{RawLeaf, RawSegment, RawStem};
-use sylva_gpu::shader::{KERNELS, TREE, compose};
+use sylva_gpu::shaders::{KERNELS, TREE, compose};
 
 fn parse(src: &str, name: &str) -> naga::Module {
     naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)))
@@ -13,8 +13,8 @@ fn parse(src: &str, name: &str) -> naga::Module {
 #[test]
 fn every_kernel_validates_with_naga() {
     assert!(!KERNELS.is_empty());
-    for (name, parts) in KERNELS {
-        let src = compose(parts);
+    for k in KERNELS {
+        let (name, src) = (k.name, compose(k.sources));
         let module = parse(&src, name);
         Validator::new(ValidationFlags::all(), Capabilities::all())
             .validate(&module)
@@ -29,23 +29,57 @@ fn broken_wgsl_is_caught_without_a_gpu() {
     assert!(naga::front::wgsl::parse_str(&src).is_err());
 }
 
-#[test]
-fn every_wgsl_file_is_part_of_a_validated_kernel() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/shader");
-    let mut files = 0;
-    for entry in std::fs::read_dir(&dir).unwrap() {
+fn wgsl_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "wgsl") {
-            files += 1;
-            let text = std::fs::read_to_string(&path).unwrap();
-            assert!(
-                KERNELS.iter().any(|(_, parts)| parts.contains(&text.as_str())),
-                "{} is in no kernel of shader::KERNELS, so nothing validates it",
-                path.display()
-            );
+        if path.is_dir() {
+            wgsl_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "wgsl") {
+            out.push(path);
         }
     }
-    assert!(files >= 7);
+}
+
+/// Every WGSL file of the crate (but the renderer's, validated by its own test) is composed
+/// into some registered kernel, so naga validates it.
+#[test]
+fn every_wgsl_file_is_part_of_a_validated_kernel() {
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    wgsl_files(&src, &mut files);
+    files.retain(|p| !p.starts_with(src.join("render")));
+    for path in &files {
+        let text = std::fs::read_to_string(path).unwrap();
+        assert!(
+            KERNELS.iter().any(|k| k.sources.contains(&text.as_str())),
+            "{} is in no kernel of shaders::KERNELS, so nothing validates it",
+            path.display()
+        );
+    }
+    assert!(files.len() >= 30, "{} WGSL files found", files.len());
+}
+
+/// A kernel's name is its own WGSL file's stem (the last source composed) and its CPU
+/// twin's function name: the registry keeps the three together.
+#[test]
+fn every_kernel_is_named_after_its_wgsl_file_and_its_cpu_twin() {
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    wgsl_files(&src, &mut files);
+    let mut names = std::collections::BTreeSet::new();
+    for k in KERNELS {
+        assert!(names.insert(k.name), "{} is registered twice", k.name);
+        let last = k.sources.last().unwrap();
+        let file = files
+            .iter()
+            .find(|p| std::fs::read_to_string(p).unwrap() == *last)
+            .unwrap_or_else(|| panic!("{}: its last source is no file", k.name));
+        assert_eq!(file.file_stem().unwrap(), k.name, "{}: composed last from {}", k.name, file.display());
+        assert!(k.cpu_twin.starts_with("sylva_core::"), "{}: twin {}", k.name, k.cpu_twin);
+        assert_eq!(k.cpu_twin.rsplit("::").next(), Some(k.name), "{}: twin {}", k.name, k.cpu_twin);
+        assert_eq!(sylva_gpu::shaders::kernel(k.name), Some(k));
+    }
+    assert!(sylva_gpu::shaders::kernel("no_such_kernel").is_none());
 }
 
 /// (size, [(member, offset)]) of a WGSL struct, from naga's layouter.
@@ -132,9 +166,9 @@ fn pod_structs_match_their_wgsl_twins() {
 
 #[test]
 fn wind_and_noise_structs_match_their_wgsl_twins() {
+    use sylva_core::methods::zioma::trunk::RawBand;
     use sylva_core::wind::raw::{RawField, RawWave};
-    use sylva_core::wind::trunk::RawBand;
-    use sylva_gpu::shader::{NOISE, TRUNK_NOISE, WIND};
+    use sylva_gpu::shaders::{NOISE, TRUNK_NOISE, WIND};
     let wind = compose(&[NOISE, WIND]);
     check_in(
         &wind,
@@ -173,10 +207,10 @@ fn wind_and_noise_structs_match_their_wgsl_twins() {
 
 #[test]
 fn animation_structs_match_their_wgsl_twins() {
-    use sylva_core::animate::akagi::{RawAkagiSegment, RawAkagiStep};
-    use sylva_core::animate::skjermo::{RawSkjermoState, RawSkjermoStem, RawSkjermoStep};
-    use sylva_core::animate::zioma::{RawZiomaFrame, RawZiomaStem};
-    use sylva_gpu::shader::{AKAGI, NOISE, QUAT, SKJERMO, TREE, WIND, ZIOMA_ROTATIONS};
+    use sylva_core::methods::akagi::{RawAkagiSegment, RawAkagiStep};
+    use sylva_core::methods::skjermo::{RawSkjermoState, RawSkjermoStem, RawSkjermoStep};
+    use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaStem};
+    use sylva_gpu::shaders::{AKAGI, NOISE, QUAT, SKJERMO, TREE, WIND, ZIOMA_ROTATIONS};
     let zioma = compose(&[QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS]);
     check_in(
         &zioma,
@@ -277,10 +311,10 @@ fn animation_structs_match_their_wgsl_twins() {
 
 #[test]
 fn hsm_structs_match_their_wgsl_twins() {
-    use sylva_core::animate::hsm::{
+    use sylva_core::methods::hsm::{
         RawHsmCluster, RawHsmClusterInfo, RawHsmClusterState, RawHsmMember, RawHsmSlot, RawHsmStep,
     };
-    use sylva_gpu::shader::{HSM, QUAT};
+    use sylva_gpu::shaders::{HSM, QUAT};
     let hsm = compose(&[QUAT, HSM]);
     check_in(
         &hsm,
@@ -350,7 +384,7 @@ fn hsm_structs_match_their_wgsl_twins() {
 #[test]
 fn mesh_structs_match_their_wgsl_twins() {
     use sylva_core::mesh::{RawDetail, RawMeshInfo, RawRing, RawVertex};
-    use sylva_gpu::shader::{MESH, NOISE};
+    use sylva_gpu::shaders::{MESH, NOISE};
     let src = compose(&[NOISE, MESH]);
     check_in(
         &src,
@@ -410,7 +444,7 @@ fn mesh_structs_match_their_wgsl_twins() {
 #[test]
 fn skin_structs_match_their_wgsl_twins() {
     use sylva_core::mesh::{RawSkin, RawSkinInfo};
-    use sylva_gpu::shader::{MESH, NOISE, QUAT, SKIN_VERTICES};
+    use sylva_gpu::shaders::{MESH, NOISE, QUAT, SKIN_VERTICES};
     let src = compose(&[QUAT, NOISE, MESH, SKIN_VERTICES]);
     check_in(
         &src,
@@ -439,7 +473,7 @@ fn skin_structs_match_their_wgsl_twins() {
 #[test]
 fn deformer_structs_match_their_wgsl_twins() {
     use sylva_core::mesh::{RawDeformRing, RawDeformShape};
-    use sylva_gpu::shader::{MESH, NOISE, QUAT, SKJERMO, SKJERMO_DEFORM};
+    use sylva_gpu::shaders::{MESH, NOISE, QUAT, SKJERMO, SKJERMO_DEFORM};
     let src = compose(&[QUAT, TREE, NOISE, MESH, SKJERMO, SKJERMO_DEFORM]);
     check_in(
         &src,
@@ -489,8 +523,8 @@ fn wgsl_f32_const(src: &str, name: &str) -> f32 {
 /// values on both sides.
 #[test]
 fn hsm_constants_match_their_cpu_twins() {
-    use sylva_core::cpu::hsm::{MAX_WEIGHT, NEWTON_NEAR};
-    let src = compose(&[sylva_gpu::shader::QUAT, sylva_gpu::shader::HSM]);
+    use sylva_core::methods::hsm::kernels::{MAX_WEIGHT, NEWTON_NEAR};
+    let src = compose(&[sylva_gpu::shaders::QUAT, sylva_gpu::shaders::HSM]);
     assert_eq!(wgsl_f32_const(&src, "NEWTON_NEAR"), NEWTON_NEAR);
     assert_eq!(wgsl_f32_const(&src, "MAX_WEIGHT"), MAX_WEIGHT);
 }

@@ -2,11 +2,14 @@
 
 mod common;
 
-use sylva_core::animate::Pose;
-use sylva_core::animate::skjermo::{Skjermo, SkjermoParams};
+use std::sync::Arc;
+use sylva_core::methods::Method;
+use sylva_core::methods::skjermo::{Skjermo, SkjermoParams};
+use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
-use sylva_gpu::pose::GpuSkjermo;
+use sylva_gpu::wind::GpuWind;
+use sylva_gpu::methods::skjermo::GpuSkjermo;
 
 /// Joint positions and control points within 1e-4 × tree height after 1,000 steps at 60 Hz
 /// in gusty wind.
@@ -14,17 +17,17 @@ use sylva_gpu::pose::GpuSkjermo;
 fn skjermo_matches_after_1000_steps_on_every_preset() {
     let Some(ctx) = common::gpu() else { return };
     let wind = WindScene::resolve("gusty").unwrap();
-    let (f, w) = wind.pack();
+    let fw = wind.packed();
     for p in PRESETS {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
         let m = Skjermo::new(&t, SkjermoParams::default());
         let mut cpu = m.rest_state(&t);
-        let mut gpu = GpuSkjermo::new(ctx, &t, &m, &wind).unwrap();
+        let mut gpu = GpuSkjermo::new(ctx, Arc::new(t.clone()), &m, &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
         for _ in 0..1000 {
-            m.step(&t, &f, &w, &mut cpu, 1.0 / 60.0);
+            m.step(&t, &fw, &mut cpu, 1.0 / 60.0);
             gpu.step(ctx, 1.0 / 60.0);
         }
-        let g = gpu.read(ctx, &m).unwrap();
+        let g = gpu.read(ctx).unwrap();
         let tol = 1e-4 * t.height();
         let mut worst = 0.0f32;
         for i in 0..t.segments.len() {
@@ -47,11 +50,11 @@ fn skjermo_on_the_gpu_stays_at_rest_in_still_air() {
     let Some(ctx) = common::gpu() else { return };
     let t = SpeciesSource::resolve("black_tupelo").unwrap().generate(1, &Default::default(), None).unwrap();
     let m = Skjermo::new(&t, SkjermoParams::default());
-    let mut g = GpuSkjermo::new(ctx, &t, &m, &WindScene::default()).unwrap();
+    let mut g = GpuSkjermo::new(ctx, Arc::new(t.clone()), &m, &GpuWind::calm(ctx).unwrap()).unwrap();
     for _ in 0..20 {
         g.step(ctx, 1.0 / 60.0);
     }
-    let pose = g.read(ctx, &m).unwrap();
+    let pose = g.read(ctx).unwrap();
     assert_eq!(pose.start, Pose::rest(&t).start);
     assert_eq!(pose.bezier.unwrap(), t.stems.bezier);
 }

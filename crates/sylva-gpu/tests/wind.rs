@@ -4,7 +4,7 @@ mod common;
 
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
-use sylva_core::wind::trunk::TrunkNoise;
+use sylva_core::methods::zioma::trunk::TrunkNoise;
 use sylva_core::wind::*;
 
 const SAMPLES: usize = 1_000_000;
@@ -141,16 +141,16 @@ fn every_field_matches_on_a_million_random_samples() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(2024);
     let s = samples(1);
     for (name, scene, peak, tol) in scenes(&mut rng) {
-        let gpu = sylva_gpu::wind_sample::WindSampler::new(ctx, &scene).unwrap().sample(ctx, &s).unwrap();
-        let (fields, waves) = scene.pack();
+        let gpu = sylva_gpu::wind::WindSampler::new(ctx, &scene).unwrap().sample(ctx, &s).unwrap();
+        let fieldswaves = scene.packed();
         let mut cpu = vec![[0.0f32; 4]; s.len()];
-        sylva_core::cpu::wind_sample(&fields, &waves, &s, &mut cpu);
+        sylva_core::wind::sample::wind_sample(&fieldswaves.fields, &fieldswaves.waves, &s, &mut cpu);
         let mut worst = 0.0f32;
         let mut worst_share = 0.0f32;
         let mut nonzero = 0usize;
         for i in 0..s.len() {
             let d = (Vec3::from_slice(&gpu[i][..3]) - Vec3::from_slice(&cpu[i][..3])).length();
-            let bound = tol * peak + phase_allowance(&fields, &waves, s[i]);
+            let bound = tol * peak + phase_allowance(&fieldswaves.fields, &fieldswaves.waves, s[i]);
             worst = worst.max(d / peak);
             worst_share = worst_share.max(d / bound);
             assert!(d <= bound, "{name}: sample {i} {:?}: |Δv| = {d:e} > {bound:e}", s[i]);
@@ -176,11 +176,11 @@ fn a_composed_scene_matches_too() {
         peak += p;
     }
     let s = samples(2);
-    let gpu = sylva_gpu::wind_sample::WindSampler::new(ctx, &scene).unwrap().sample(ctx, &s[..200_000]).unwrap();
-    let (fields, waves) = scene.pack();
+    let gpu = sylva_gpu::wind::WindSampler::new(ctx, &scene).unwrap().sample(ctx, &s[..200_000]).unwrap();
+    let fieldswaves = scene.packed();
     for (i, x) in s[..200_000].iter().enumerate().step_by(7) {
         let cpu = scene.sample(Vec3::new(x[0], x[1], x[2]), x[3]);
-        let bound = 1e-5 * peak + phase_allowance(&fields, &waves, *x);
+        let bound = 1e-5 * peak + phase_allowance(&fieldswaves.fields, &fieldswaves.waves, *x);
         assert!((Vec3::from_slice(&gpu[i][..3]) - cpu).length() <= bound, "sample {i}");
     }
 }
@@ -195,9 +195,9 @@ fn trunk_noise_matches_on_a_million_samples() {
     let s: Vec<[f32; 4]> = (0..SAMPLES)
         .map(|_| [rng.random_range(0.0..600.0), f32::from_bits(rng.random::<u32>() & 0x3fff_ffff), 0.0, 0.0])
         .collect();
-    let gpu = sylva_gpu::trunk_noise::trunk_noise(ctx, &noise.bands, &s).unwrap();
+    let gpu = sylva_gpu::methods::zioma::trunk_noise::trunk_noise(ctx, &noise.bands, &s).unwrap();
     let mut cpu = vec![[0.0f32; 4]; s.len()];
-    sylva_core::cpu::trunk_noise(&noise.bands, &s, &mut cpu);
+    sylva_core::methods::zioma::trunk::trunk_noise(&noise.bands, &s, &mut cpu);
     let mut worst = 0.0f32;
     for i in 0..s.len() {
         for a in 0..3 {
@@ -212,7 +212,7 @@ fn trunk_noise_matches_on_a_million_samples() {
 fn kernel_timing_is_reported() {
     let Some(ctx) = common::gpu() else { return };
     let scene = WindScene { fields: vec![WindField::Constant(Constant { direction: [1.0, 0.0, 0.0], speed: 3.0 })] };
-    let sampler = sylva_gpu::wind_sample::WindSampler::new(ctx, &scene).unwrap();
+    let sampler = sylva_gpu::wind::WindSampler::new(ctx, &scene).unwrap();
     let (v, timing) = sampler.sample_timed(ctx, &samples(3)[..10_000]).unwrap();
     assert_eq!(v[0][0], 3.0);
     assert!(timing.wall.as_nanos() > 0);
@@ -233,7 +233,7 @@ fn gpu_timer_brackets_several_submissions() {
         return;
     };
     let scene = WindScene { fields: vec![WindField::Constant(Constant { direction: [1.0, 0.0, 0.0], speed: 3.0 })] };
-    let sampler = sylva_gpu::wind_sample::WindSampler::new(ctx, &scene).unwrap();
+    let sampler = sylva_gpu::wind::WindSampler::new(ctx, &scene).unwrap();
     let input = sylva_gpu::kernel::upload(ctx, "timer samples", &samples(5)[..100_000]).unwrap();
     ctx.wait().unwrap();
     let wall = std::time::Instant::now();

@@ -18,23 +18,19 @@
 //! stays connected while blending. The last frame is a copy of the first (glTF clips play
 //! from the first key to the last).
 
-use crate::animate::{CpuAnimator, hsm::HsmError};
 use crate::mesh::quat_slerp;
+use crate::methods::{Animator, MethodError};
 use crate::model::{NONE, Tree};
-use crate::scene::MethodName;
+use crate::pose::SeamPose;
 use crate::wind::WindScene;
 use glam::{Quat, Vec3};
 
 /// Largest `frames × segments` a clip may hold (32 bytes each: 512 MiB).
 pub const MAX_CLIP_VALUES: u64 = 16 << 20;
 
-/// How to bake.
+/// How to bake (the method is the caller's: any [`Animator`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BakeParams {
-    /// Animation method.
-    pub method: MethodName,
-    /// Seed of the method's own randomness (Zioma's branch phases).
-    pub seed: u64,
     /// Clip length, s.
     pub seconds: f32,
     /// Frames per second of the clip.
@@ -54,16 +50,7 @@ pub struct BakeParams {
 
 impl Default for BakeParams {
     fn default() -> Self {
-        Self {
-            method: MethodName::Zioma,
-            seed: 1,
-            seconds: 10.0,
-            fps: 30.0,
-            looped: false,
-            blend: 1.0,
-            preroll: 2.0,
-            sim_rate: 120.0,
-        }
+        Self { seconds: 10.0, fps: 30.0, looped: false, blend: 1.0, preroll: 2.0, sim_rate: 120.0 }
     }
 }
 
@@ -80,7 +67,7 @@ pub enum BakeError {
     TooLarge { frames: u64, segments: u64, limit: u64 },
     /// The method could not be built.
     #[error(transparent)]
-    Method(#[from] HsmError),
+    Method(#[from] MethodError),
 }
 
 /// A baked animation: the pose seam's buffers per frame.
@@ -160,34 +147,32 @@ impl BakeParams {
     }
 }
 
-/// Bakes `params.method` on `tree` in `wind`. `progress(done, total)` is called after each
-/// simulated frame.
+/// Bakes `anim` (from its current state, in `wind`) into a clip: `params.preroll` of
+/// simulated time first, then a key every `1 / fps` s. `progress(done, total)` is called
+/// after each simulated frame.
 pub fn bake(
-    tree: &Tree,
+    anim: &mut dyn Animator,
     wind: &WindScene,
     params: &BakeParams,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Clip, BakeError> {
+    let tree = anim.tree().clone();
+    let tree = &*tree;
     let (n, blend, steps) = params.check(tree.segments.len())?;
-    let mut anim = CpuAnimator::new(tree, params.method, params.seed)?;
-    let (fields, waves) = wind.pack();
+    anim.set_wind(std::sync::Arc::new(wind.packed()));
     let dt = 1.0 / (params.fps * steps as f32);
     // Preroll: whole frames of simulated time before frame 0.
     let pre_frames = (params.preroll * params.fps).round() as usize;
-    if anim.is_stateful() {
-        for _ in 0..pre_frames {
-            anim.advance(tree, &fields, &waves, 0.0, dt, steps);
-        }
-    }
-    let t0 = pre_frames as f32 / params.fps;
+    anim.advance(dt, pre_frames * steps);
     let total = n + 1 + blend;
     let mut joints = Vec::with_capacity(total);
     let mut acc = Vec::with_capacity(total);
+    let mut seam = SeamPose::default();
     for k in 0..total {
-        let (j, a) =
-            anim.advance(tree, &fields, &waves, t0 + k as f32 / params.fps, dt, if k == 0 { 0 } else { steps });
-        joints.push(j);
-        acc.push(a);
+        anim.advance(dt, if k == 0 { 0 } else { steps });
+        anim.seam(&mut seam);
+        joints.push(seam.joints.clone());
+        acc.push(seam.acc.clone());
         progress(k + 1, total);
     }
     if params.looped {

@@ -6,7 +6,7 @@
 //! repeat); a leaf's `u` runs across the blade (0.5 the midrib) and `v` from the base
 //! (image row 0) to the tip (the last row).
 
-use crate::cpu::noise::hash_unit;
+use crate::wind::noise::hash_unit;
 use std::f32::consts::{PI, TAU};
 
 /// Side of each texture, pixels.

@@ -15,7 +15,7 @@
 //!    carried through eq. 9 analytically (the Jacobian–vector products), `n = ∂P/∂θ × ∂P/∂u`.
 //!
 //! Each frame reads the stems' control points as Skjermo's method keeps them (rest plus
-//! per-step displacement, [`crate::animate::skjermo`]). The CPU reference
+//! per-step displacement, [`crate::methods::skjermo`]). The CPU reference
 //! `cpu::skjermo_deform` is the twin of `skjermo_deform.wgsl` (one ring per work item).
 
 use super::{MIN_RADIUS_FRACTION, MeshError, RawMeshInfo};

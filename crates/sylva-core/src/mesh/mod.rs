@@ -41,13 +41,23 @@
 //! `sylva-gpu`'s `mesh_tubes.wgsl` and `mesh_leaves.wgsl` (one invocation per vertex).
 
 pub mod deformer;
+mod detail;
+mod leaves;
 pub mod skin;
+mod skin_vertices;
+mod skjermo_deform;
+mod tubes;
 
 pub use deformer::{DeformLayout, DeformerParams, RawDeformRing, RawDeformShape, deform_radius};
+pub use detail::mesh_detail;
+pub use leaves::mesh_leaves;
 pub use skin::{RawSkin, RawSkinInfo, SkinLayout};
+pub use skin_vertices::skin_vertices;
+pub use skjermo_deform::skjermo_deform;
+pub use tubes::mesh_tubes;
 
-use crate::animate::Pose;
 use crate::model::{NONE, RawLeaf, RawSegment, Tree};
+use crate::pose::Pose;
 use bytemuck::{Pod, Zeroable};
 use glam::Quat;
 
@@ -520,7 +530,7 @@ impl MeshLayout {
 
     /// The mesh of `pose`, on the CPU (rayon).
     pub fn mesh(&self, tree: &Tree, pose: &Pose) -> MeshFrame {
-        let (joint, acc) = pose_buffers(tree, pose);
+        let (joint, acc) = crate::pose::pose_buffers(tree, pose);
         self.mesh_raw(&joint, &acc)
     }
 
@@ -529,25 +539,12 @@ impl MeshLayout {
         let info = self.info();
         let mut tubes = vec![RawVertex::zeroed(); self.tube_vertex_count()];
         let ring_vertices = self.rings.len() * (self.params.sides as usize + 1);
-        crate::cpu::mesh_tubes(&info, &self.rings, &self.segments, joint, acc, &mut tubes[..ring_vertices]);
-        crate::cpu::mesh_detail(&info, &self.details, &mut tubes);
+        crate::mesh::mesh_tubes(&info, &self.rings, &self.segments, joint, acc, &mut tubes[..ring_vertices]);
+        crate::mesh::mesh_detail(&info, &self.details, &mut tubes);
         let mut leaves = vec![RawVertex::zeroed(); self.leaf_vertex_count()];
-        crate::cpu::mesh_leaves(&info, &self.leaves, &self.segments, joint, acc, &mut leaves);
+        crate::mesh::mesh_leaves(&info, &self.leaves, &self.segments, joint, acc, &mut leaves);
         MeshFrame { tubes, leaves }
     }
-}
-
-/// A pose as the GPU pose seam stores it: joint positions (w = 0) and accumulated
-/// rotations `D = Q · Q_rest⁻¹`.
-pub fn pose_buffers(tree: &Tree, pose: &Pose) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
-    let joint = pose.start.iter().map(|p| p.extend(0.0).to_array()).collect();
-    let acc = pose
-        .orientation
-        .iter()
-        .zip(&tree.segments.orientation)
-        .map(|(q, r)| (*q * r.conjugate()).normalize().to_array())
-        .collect();
-    (joint, acc)
 }
 
 /// Spherical linear interpolation of unit quaternions along the shorter arc; nlerp when
@@ -572,7 +569,7 @@ pub fn quat_slerp(a: Quat, b: Quat, t: f32) -> Quat {
 pub fn bark_relief(u: f32, v: f32, seed: u32) -> f32 {
     // Seven ridges around the stem (an integer count keeps the relief periodic in u),
     // wandering sideways with height by 1-D noise along v.
-    let wander = crate::cpu::noise::value_noise(v * 0.6, seed);
+    let wander = crate::wind::noise::value_noise(v * 0.6, seed);
     let ridge = (std::f32::consts::TAU * (u * 7.0 + 0.8 * wander)).sin();
     ridge * ridge * 2.0 - 1.0
 }

@@ -113,7 +113,7 @@ impl SkinLayout {
             let info =
                 RawSkinInfo { vertices: rest.len() as u32, segments: self.segments, instances, first_instance: 0 };
             let mut out = vec![RawVertex::zeroed(); rest.len() * instances as usize];
-            crate::cpu::skin_vertices(&info, rest, skin, &self.rest_joint, joint, acc, &mut out);
+            crate::mesh::skin_vertices(&info, rest, skin, &self.rest_joint, joint, acc, &mut out);
             out
         };
         super::MeshFrame { tubes: run(&self.tube_rest, &self.tube_skin), leaves: run(&self.leaf_rest, &self.leaf_skin) }

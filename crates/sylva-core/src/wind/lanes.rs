@@ -4,8 +4,8 @@
 //! lanes, the localised events (gust front, vortex, blast) per lane through `field_at`.
 //! Agrees with `wind_at` to the sine's error (tested).
 
-use crate::cpu::wind_sample::field_at;
 use crate::wind::raw::{RawField, RawWave, kind};
+use crate::wind::sample::field_at;
 use glam::Vec3;
 use std::f32::consts::TAU;
 use std::ops::{Add, Sub};
@@ -180,8 +180,8 @@ pub fn wind_lanes(fields: &[RawField], waves: &[RawWave], p: V3, t: f32) -> V3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cpu::wind_sample::wind_at;
     use crate::wind::WindScene;
+    use crate::wind::sample::wind_at;
 
     #[test]
     fn lane_sine_is_within_its_stated_error() {

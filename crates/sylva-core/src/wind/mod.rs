@@ -18,11 +18,12 @@
 //! the CPU twin of the WGSL kernel, so the friendly API and the GPU share one definition.
 
 pub mod lanes;
+pub mod noise;
 pub mod raw;
-pub mod trunk;
+pub mod sample;
 
-use crate::cpu::wind_sample::wind_at;
 use crate::rng::{Stream, mix64};
+use crate::wind::sample::wind_at;
 use glam::Vec3;
 use raw::{RawField, RawWave, kind};
 use serde::{Deserialize, Serialize};
@@ -231,6 +232,28 @@ pub enum WindError {
     Io { file: String, message: String },
 }
 
+/// A wind scene in the packed form every kernel reads: one record per field and a table of
+/// waves ([`WindScene::pack`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PackedWind {
+    /// One record per field.
+    pub fields: Vec<RawField>,
+    /// Waves of the sums of sines and of turbulence.
+    pub waves: Vec<RawWave>,
+}
+
+impl PackedWind {
+    /// Still air.
+    pub fn calm() -> Self {
+        Self::default()
+    }
+
+    /// Wind velocity at `p` and `t`, m/s.
+    pub fn at(&self, p: Vec3, t: f32) -> Vec3 {
+        wind_at(&self.fields, &self.waves, p, t)
+    }
+}
+
 /// Wind scenes shipped in `presets/wind/`: (name, file, text).
 pub const PRESETS: &[(&str, &str, &str)] = &[
     ("gusty", "presets/wind/gusty.toml", include_str!("../../../../presets/wind/gusty.toml")),
@@ -285,7 +308,7 @@ impl WindScene {
     /// Reads a TOML file.
     pub fn load(path: &Path) -> Result<Self, WindError> {
         let file = path.display().to_string();
-        let text = crate::species::read_text(path).map_err(|message| WindError::Io { file: file.clone(), message })?;
+        let text = crate::io::read_text(path).map_err(|message| WindError::Io { file: file.clone(), message })?;
         Self::from_toml(&text, &file)
     }
 
@@ -458,8 +481,14 @@ impl WindScene {
         (fields, waves)
     }
 
+    /// [`Self::pack`] as one value.
+    pub fn packed(&self) -> PackedWind {
+        let (fields, waves) = self.pack();
+        PackedWind { fields, waves }
+    }
+
     /// Wind velocity at `p` and `t` (packs the scene each call; pack once and use
-    /// [`crate::cpu::wind_sample::wind_at`] in loops).
+    /// [`crate::wind::sample::wind_at`] in loops).
     pub fn sample(&self, p: Vec3, t: f32) -> Vec3 {
         let (f, w) = self.pack();
         wind_at(&f, &w, p, t)

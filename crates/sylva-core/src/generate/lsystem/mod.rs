@@ -169,8 +169,7 @@ impl Grammar {
     /// Reads and parses a grammar file (at most 1 MiB).
     pub fn load(path: &Path) -> Result<Self, GrammarError> {
         let file = path.display().to_string();
-        let text =
-            crate::species::read_text(path).map_err(|message| GrammarError::Io { file: file.clone(), message })?;
+        let text = crate::io::read_text(path).map_err(|message| GrammarError::Io { file: file.clone(), message })?;
         Self::parse(&text, &file)
     }
 

@@ -1,0 +1,474 @@
+//! glTF 2.0 export: the tree's mesh with PBR materials and embedded textures, a skin, an
+//! animation baked from any method, hierarchy attributes for engine-side wind shaders, and
+//! level-of-detail meshes. `.glb` (binary, one file) or `.gltf` (JSON with the buffer and
+//! textures embedded as data URIs, also one file), written atomically.
+//!
+//! # Skin
+//!
+//! Joints are nodes under an `armature` node, one per segment ([`JointMode::Segment`]) or
+//! one per stem ([`JointMode::Stem`], for engines with a bone limit). Every joint's rest
+//! frame is its driving segment's joint position with the world axes (inverse bind matrix
+//! a pure translation), so a joint's world transform at a frame is exactly Sylva's bone
+//! transform `x ↦ j + D (x − j_rest)` ([`crate::mesh::skin`]). Vertices carry at most two
+//! joints (`JOINTS_0` u16, `WEIGHTS_0` float, summing to 1): a bark vertex blends its
+//! segment with the neighbour toward the nearer joint, a leaf follows its segment.
+//!
+//! **Merging per stem**: stem `k`'s joint is driven by the stem's first segment (its base),
+//! and every vertex of the stem is bound to it, so a stem moves as a rigid body about its
+//! base. The blend toward the neighbouring segment is kept only where that segment belongs
+//! to another stem (never, for tubes: stems do not share rings), so bends *within* a stem
+//! are lost — the price of one bone per stem.
+//!
+//! # Animation
+//!
+//! One clip, `wind`, with a key per frame of the [`Clip`] (linear interpolation): a
+//! rotation channel per joint that moves, and a translation channel for a joint whose
+//! offset from its parent changes. The four methods pose by forward kinematics, so their
+//! clips need rotations only; a clip whose joints leave their parents' (a pose from
+//! cluster centres, say) gets translations too. Consecutive rotation keys are kept in the
+//! same hemisphere so interpolation takes the short way.
+//!
+//! # Hierarchy attributes (Pivot Painter style)
+//!
+//! Every vertex also carries, in the rest pose and metres (custom attributes, float):
+//!
+//! * `_PIVOT` (VEC3): where its element rotates — the base of its stem for bark, the
+//!   attachment point for a leaf;
+//! * `_BRANCH_AXIS` (VEC3, unit): the element's rest direction — base to tip of the stem,
+//!   the blade's midrib for a leaf;
+//! * `_HIERARCHY_DEPTH` (SCALAR): 0 trunk, 1 its branches, …; a leaf is its stem's depth + 1;
+//! * `_PARENT_PIVOT` (VEC3): the pivot of the element it hangs on (the trunk: its own);
+//! * `_PHASE` (SCALAR, 0…1): a random number per element (stable per tree and seed), for
+//!   Zioma's per-branch phase shift.
+//!
+//! With these an engine shader can rotate each vertex about `_PIVOT` around an axis
+//! perpendicular to `_BRANCH_AXIS` and the wind, then about `_PARENT_PIVOT`, scaling the
+//! motion with depth — Zioma's hierarchy on a static mesh. `docs/GLTF.md` gives a shader.
+//!
+//! # Levels of detail
+//!
+//! Each [`Lod`] is a separate mesh (`<tree>_LOD0`, `_LOD1`, …, the engines' naming) on its
+//! own node, all bound to the same skin: fewer tube sides, fewer rings per segment, fewer
+//! leaf sides and fewer (larger) leaves ([`MeshLayout::thin_leaves`]).
+
+mod builder;
+mod rig;
+
+pub use rig::tangents;
+
+use super::bake::Clip;
+use super::textures;
+use crate::io::write_atomic;
+use crate::mesh::{MeshError, MeshLayout, MeshParams, RawSkin, RawVertex, SkinLayout};
+use crate::model::{NONE, RawLeaf, Tree};
+use builder::Builder;
+use glam::{Mat4, Quat, Vec3};
+use gltf::json;
+use json::validation::{Checked::Valid, USize64};
+use rig::{Geometry, Hierarchy, Rig};
+use std::borrow::Cow;
+use std::path::Path;
+
+/// What a skin joint stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum JointMode {
+    /// One joint per segment: the full motion.
+    #[default]
+    Segment,
+    /// One joint per stem, driven by its base segment (see the module documentation).
+    Stem,
+}
+
+impl JointMode {
+    fn as_str(self) -> &'static str {
+        match self {
+            Self::Segment => "one per segment",
+            Self::Stem => "one per stem",
+        }
+    }
+}
+
+/// One level of detail.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lod {
+    /// Tube sides.
+    pub sides: u32,
+    /// Rings per segment.
+    pub samples: u32,
+    /// Leaf polygon sides.
+    pub leaf_sides: u32,
+    /// Fraction of the leaves kept (0…1], the rest scaled up to keep the leaf area.
+    pub leaf_keep: f32,
+}
+
+/// The default levels: full detail; about half; about a fifth.
+pub const DEFAULT_LODS: [Lod; 3] = [
+    Lod { sides: 8, samples: 3, leaf_sides: 8, leaf_keep: 1.0 },
+    Lod { sides: 6, samples: 2, leaf_sides: 6, leaf_keep: 0.5 },
+    Lod { sides: 4, samples: 1, leaf_sides: 4, leaf_keep: 0.25 },
+];
+
+/// Export options.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GltfOptions {
+    /// Joints per segment or per stem.
+    pub joints: JointMode,
+    /// Refuse to write more joints than this (an engine's bone limit).
+    pub max_joints: Option<usize>,
+    /// Levels of detail, finest first (at least one).
+    pub lods: Vec<Lod>,
+}
+
+impl Default for GltfOptions {
+    fn default() -> Self {
+        Self { joints: JointMode::Segment, max_joints: None, lods: DEFAULT_LODS.to_vec() }
+    }
+}
+
+/// Joint indices are u16 in `JOINTS_0`.
+pub const MAX_JOINTS: usize = 65_535;
+/// Largest binary payload written, bytes (1 GiB).
+pub const MAX_BIN_BYTES: u64 = 1 << 30;
+/// Most levels of detail.
+pub const MAX_LODS: usize = 8;
+
+/// Errors exporting glTF.
+#[derive(Debug, thiserror::Error)]
+pub enum GltfError {
+    /// An option is out of range.
+    #[error("export option `{field}` = {value}: expected {expected}")]
+    Param { field: &'static str, value: String, expected: String },
+    /// A level of detail could not be meshed.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// More joints than allowed.
+    #[error("the skin would have {joints} joints ({mode}), more than the limit of {limit}{hint}")]
+    TooManyJoints { joints: usize, limit: usize, mode: &'static str, hint: &'static str },
+    /// The file would be too large.
+    #[error(
+        "the file would hold {bytes} bytes of data; the limit is {limit} (shorten the clip or use joints per stem)"
+    )]
+    TooLarge { bytes: u64, limit: u64 },
+    /// The clip does not belong to the tree.
+    #[error("the clip has {clip} segments per frame but the tree has {tree}")]
+    ClipMismatch { clip: usize, tree: usize },
+    /// Writing failed.
+    #[error("{path}: {message}")]
+    Io { path: String, message: String },
+}
+
+/// What one level of detail holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LodReport {
+    /// Its parameters.
+    pub lod: Lod,
+    /// Triangles (bark + leaves).
+    pub triangles: usize,
+    /// Vertices (bark + leaves).
+    pub vertices: usize,
+    /// Leaves kept.
+    pub leaves: usize,
+    /// Bytes of its geometry in the file.
+    pub bytes: usize,
+}
+
+/// What was exported.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExportReport {
+    /// Per level of detail.
+    pub lods: Vec<LodReport>,
+    /// Skin joints (0 for a static export).
+    pub joints: usize,
+    /// Animation keys per channel (0 for a static export).
+    pub frames: usize,
+    /// Animation channels.
+    pub channels: usize,
+    /// Bytes of textures.
+    pub texture_bytes: usize,
+    /// Bytes of the skin and animation data.
+    pub animation_bytes: usize,
+    /// Bytes of the binary payload in all.
+    pub bin_bytes: usize,
+}
+
+/// A built document: the JSON and its binary buffer.
+#[derive(Debug)]
+pub struct GltfDocument {
+    /// The glTF JSON.
+    pub root: json::Root,
+    /// The one buffer (length a multiple of 4).
+    pub bin: Vec<u8>,
+    /// Counts and sizes.
+    pub report: ExportReport,
+}
+
+impl GltfDocument {
+    /// Binary glTF (`.glb`).
+    pub fn write_glb(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
+        let json = json::serialize::to_vec(&self.root).map_err(std::io::Error::other)?;
+        let glb = gltf::binary::Glb {
+            header: gltf::binary::Header { magic: *b"glTF", version: 2, length: 0 },
+            json: Cow::Owned(json),
+            bin: Some(Cow::Borrowed(&self.bin)),
+        };
+        glb.to_writer(w).map_err(|e| std::io::Error::other(e.to_string()))
+    }
+
+    /// JSON glTF (`.gltf`) with the buffer embedded as a base64 data URI.
+    pub fn write_gltf_json(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
+        use base64::Engine;
+        let mut root = self.root.clone();
+        root.buffers[0].uri = Some(format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&self.bin)
+        ));
+        json::serialize::to_writer_pretty(w, &root).map_err(std::io::Error::other)
+    }
+}
+
+/// Builds the document of `tree` (static when `clip` is `None`).
+pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Result<GltfDocument, GltfError> {
+    if opts.lods.is_empty() || opts.lods.len() > MAX_LODS {
+        return Err(GltfError::Param {
+            field: "lods",
+            value: opts.lods.len().to_string(),
+            expected: format!("1 to {MAX_LODS} levels of detail"),
+        });
+    }
+    let n = tree.segments.len();
+    if let Some(c) = clip {
+        if let Some(bad) = c.joints.iter().chain(&c.acc).find(|f| f.len() != n) {
+            return Err(GltfError::ClipMismatch { clip: bad.len(), tree: n });
+        }
+        if c.frames() < 2 {
+            return Err(GltfError::Param {
+                field: "clip",
+                value: format!("{} frames", c.frames()),
+                expected: "at least 2 frames".into(),
+            });
+        }
+    }
+    let rig = Rig::new(tree, opts.joints);
+    let limit = opts.max_joints.unwrap_or(MAX_JOINTS).min(MAX_JOINTS);
+    if clip.is_some() && rig.driver.len() > limit {
+        return Err(GltfError::TooManyJoints {
+            joints: rig.driver.len(),
+            limit,
+            mode: opts.joints.as_str(),
+            hint: if opts.joints == JointMode::Segment { " (try joints per stem)" } else { "" },
+        });
+    }
+    let mut b = Builder { root: json::Root::default(), bin: Vec::new() };
+    b.root.asset = json::Asset {
+        version: "2.0".into(),
+        generator: Some(format!("Sylva {}", env!("CARGO_PKG_VERSION"))),
+        copyright: None,
+        min_version: None,
+        extensions: None,
+        extras: Default::default(),
+    };
+    b.root.buffers.push(json::Buffer {
+        byte_length: USize64(0),
+        name: None,
+        uri: None,
+        extensions: None,
+        extras: Default::default(),
+    });
+
+    // Materials and textures.
+    let before = b.bin.len();
+    let sampler = b.root.push(json::texture::Sampler {
+        mag_filter: Some(Valid(json::texture::MagFilter::Linear)),
+        min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
+        wrap_s: Valid(json::texture::WrappingMode::Repeat),
+        wrap_t: Valid(json::texture::WrappingMode::Repeat),
+        ..Default::default()
+    });
+    let bark_tex = b.texture("bark", &textures::bark_png(), sampler);
+    let leaf_tex = b.texture("leaf", &textures::leaf_png(), sampler);
+    let bark_normal = b.texture("bark_normal", &textures::bark_normal_png(), sampler);
+    let leaf_normal = b.texture("leaf_normal", &textures::leaf_normal_png(), sampler);
+    let texture_bytes = b.bin.len() - before;
+    let material = |name: &str, tex, normal, roughness: f32, leaf: bool| json::Material {
+        name: Some(name.into()),
+        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+            base_color_texture: Some(json::texture::Info {
+                index: tex,
+                tex_coord: 0,
+                extensions: None,
+                extras: Default::default(),
+            }),
+            metallic_factor: json::material::StrengthFactor(0.0),
+            roughness_factor: json::material::StrengthFactor(roughness),
+            ..Default::default()
+        },
+        normal_texture: Some(json::material::NormalTexture {
+            index: normal,
+            scale: 1.0,
+            tex_coord: 0,
+            extensions: None,
+            extras: Default::default(),
+        }),
+        alpha_mode: Valid(if leaf { json::material::AlphaMode::Mask } else { json::material::AlphaMode::Opaque }),
+        alpha_cutoff: leaf.then_some(json::material::AlphaCutoff(0.5)),
+        double_sided: leaf,
+        ..Default::default()
+    };
+    let bark_mat = b.root.push(material("bark", bark_tex, bark_normal, 0.9, false));
+    let leaf_mat = b.root.push(material("leaf", leaf_tex, leaf_normal, 0.55, true));
+
+    // Skin: the armature and its joints.
+    let height = tree.bounds().1.y - tree.bounds().0.y;
+    let rest: Vec<Vec3> = rig.driver.iter().map(|&s| tree.segments.start[s]).collect();
+    let mut scene_nodes = Vec::new();
+    let mut skin = None;
+    let mut joint_nodes = Vec::new();
+    let anim_before = b.bin.len();
+    if clip.is_some() {
+        let armature = b.root.push(json::Node { name: Some("armature".into()), ..Default::default() });
+        scene_nodes.push(armature);
+        let first = b.root.nodes.len() as u32;
+        joint_nodes = (0..rig.driver.len() as u32).map(|j| json::Index::new(first + j)).collect();
+        for (j, &p) in rig.parent.iter().enumerate() {
+            let local = if p == NONE { rest[j] } else { rest[j] - rest[p as usize] };
+            b.root.push(json::Node {
+                name: Some(rig.name(j)),
+                translation: Some(local.to_array()),
+                ..Default::default()
+            });
+        }
+        let mut roots = Vec::new();
+        let mut children = vec![Vec::new(); rig.driver.len()];
+        for (j, &p) in rig.parent.iter().enumerate() {
+            if p == NONE { roots.push(joint_nodes[j]) } else { children[p as usize].push(joint_nodes[j]) }
+        }
+        b.root.nodes[armature.value()].children = Some(roots);
+        for (j, c) in children.into_iter().enumerate() {
+            if !c.is_empty() {
+                b.root.nodes[joint_nodes[j].value()].children = Some(c);
+            }
+        }
+        let ibm: Vec<f32> = rest.iter().flat_map(|r| Mat4::from_translation(-*r).to_cols_array()).collect();
+        let ibm = b.accessor(
+            bytemuck::cast_slice(&ibm),
+            rest.len(),
+            json::accessor::ComponentType::F32,
+            json::accessor::Type::Mat4,
+            None,
+            None,
+        );
+        skin = Some(b.root.push(json::Skin {
+            name: Some("tree".into()),
+            inverse_bind_matrices: Some(ibm),
+            joints: joint_nodes.clone(),
+            skeleton: Some(armature),
+            extensions: None,
+            extras: Default::default(),
+        }));
+    }
+
+    // Meshes, one per level of detail.
+    let hier = Hierarchy::new(tree);
+    let mut lods = Vec::new();
+    for (k, lod) in opts.lods.iter().enumerate() {
+        let params =
+            MeshParams { sides: lod.sides, samples: lod.samples, leaf_sides: lod.leaf_sides, ..MeshParams::default() };
+        let mut layout = MeshLayout::new(tree, params)?;
+        layout.thin_leaves(lod.leaf_keep, tree.seed)?;
+        let skinned = SkinLayout::new(&layout);
+        let before = b.bin.len();
+        let mut primitives = Vec::new();
+        let bark = Geometry::new(&skinned.tube_rest, &skinned.tube_skin, &layout.tube_indices, |_, s| {
+            hier.bark(tree, s.bone0 as usize)
+        });
+        primitives.push(b.primitive(&bark, &rig, clip.is_some(), bark_mat));
+        let leaf_stride = layout.params.leaf_sides as usize + 1;
+        if !layout.leaves.is_empty() {
+            let leaves = Geometry::new(&skinned.leaf_rest, &skinned.leaf_skin, &layout.leaf_indices, |v, _| {
+                hier.leaf(tree, &layout.leaves[v / leaf_stride])
+            });
+            primitives.push(b.primitive(&leaves, &rig, clip.is_some(), leaf_mat));
+        }
+        let name = format!("{}_LOD{k}", tree.name);
+        let mesh = b.root.push(json::Mesh {
+            name: Some(name.clone()),
+            primitives,
+            weights: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        scene_nodes.push(b.root.push(json::Node { name: Some(name), mesh: Some(mesh), skin, ..Default::default() }));
+        lods.push(LodReport {
+            lod: *lod,
+            triangles: layout.triangle_count(),
+            vertices: layout.tube_vertex_count() + layout.leaf_vertex_count(),
+            leaves: layout.leaves.len(),
+            bytes: b.bin.len() - before,
+        });
+        if b.bin.len() as u64 > MAX_BIN_BYTES {
+            return Err(GltfError::TooLarge { bytes: b.bin.len() as u64, limit: MAX_BIN_BYTES });
+        }
+    }
+
+    // Animation.
+    let anim_mesh_bytes: usize = lods.iter().map(|l| l.bytes).sum();
+    let mut channels = 0;
+    if let Some(c) = clip {
+        let (samplers, chans) = b.animation(tree, c, &rig, &joint_nodes, height)?;
+        channels = chans.len();
+        b.root.push(json::Animation {
+            name: Some("wind".into()),
+            channels: chans,
+            samplers,
+            extensions: None,
+            extras: Default::default(),
+        });
+    }
+    let animation_bytes = b.bin.len() - anim_before - anim_mesh_bytes;
+    let scene = b.root.push(json::Scene {
+        name: Some(tree.name.clone()),
+        nodes: scene_nodes,
+        extensions: None,
+        extras: Default::default(),
+    });
+    b.root.scene = Some(scene);
+    while b.bin.len() % 4 != 0 {
+        b.bin.push(0);
+    }
+    b.root.buffers[0].byte_length = USize64(b.bin.len() as u64);
+    let report = ExportReport {
+        lods,
+        joints: if clip.is_some() { rig.driver.len() } else { 0 },
+        frames: clip.map_or(0, |c| c.frames()),
+        channels,
+        texture_bytes,
+        animation_bytes,
+        bin_bytes: b.bin.len(),
+    };
+    Ok(GltfDocument { root: b.root, bin: b.bin, report })
+}
+
+/// Builds and writes `path` atomically: `.glb` binary, `.gltf` JSON with data URIs.
+pub fn write_gltf(
+    tree: &Tree,
+    clip: Option<&Clip>,
+    opts: &GltfOptions,
+    path: &Path,
+) -> Result<ExportReport, GltfError> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let binary = match ext.as_deref() {
+        Some("glb") => true,
+        Some("gltf") => false,
+        _ => {
+            return Err(GltfError::Param {
+                field: "out",
+                value: path.display().to_string(),
+                expected: "a file name ending in .glb or .gltf".into(),
+            });
+        }
+    };
+    let doc = build_gltf(tree, clip, opts)?;
+    write_atomic(path, |w| if binary { doc.write_glb(w) } else { doc.write_gltf_json(w) })
+        .map_err(|e| GltfError::Io { path: path.display().to_string(), message: e.to_string() })?;
+    Ok(doc.report)
+}

@@ -1,0 +1,40 @@
+//! Akagi's per-segment and per-step records as the GPU lays them out (`akagi.wgsl`).
+
+use bytemuck::{Pod, Zeroable};
+
+/// Per-segment constants, 32 bytes. WGSL: `AkagiSegment` in `akagi.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawAkagiSegment {
+    /// Bark area facing a cross-flow, 2 r̄ L, m².
+    pub bark_area: f32,
+    /// Leaf area on the segment scaled by `leaf_drag / drag`, so one coefficient serves
+    /// both: m².
+    pub leaf_area: f32,
+    /// Moment of inertia of the subtree about the joint, kg·m².
+    pub inertia: f32,
+    /// Rotational stiffness, N·m/rad.
+    pub stiffness: f32,
+    /// Damping, N·m·s/rad.
+    pub damping: f32,
+    /// Padding.
+    pub _pad: [u32; 3],
+}
+
+/// Per-step values, 32 bytes. WGSL: `AkagiStep` in `akagi.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawAkagiStep {
+    /// Drag coefficient.
+    pub drag: f32,
+    /// Time at the end of the step, s.
+    pub time: f32,
+    /// Step, s.
+    pub dt: f32,
+    /// See [`AkagiParams::reconfiguration_speed`].
+    pub reconfiguration_speed: f32,
+    /// See [`AkagiParams::stiffening_angle`].
+    pub stiffening_angle: f32,
+    /// Padding.
+    pub _pad: [f32; 3],
+}

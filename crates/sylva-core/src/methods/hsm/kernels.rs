@@ -1,0 +1,617 @@
+//! CPU twins of `shader/hsm_clusters.wgsl`, `hsm_goals.wgsl`, `hsm_integrate.wgsl` and
+//! `hsm_pose.wgsl`: Song's four stages (see [`crate::methods::hsm`]). Same operations in the
+//! same order as the WGSL: a cluster's sums go through the GPU's [`LANES`] lanes (lane `j mod
+//! 64` takes slot `j`) and the same halving tree, so both sides add in the same order.
+
+use crate::methods::hsm::{
+    RawHsmCluster, RawHsmClusterInfo, RawHsmClusterState, RawHsmMember, RawHsmSlot, RawHsmStep, kind,
+};
+use crate::model::NONE;
+use crate::simd::dispatch;
+use crate::wind::lanes::{LANES as WIND_LANES, V3, wind_lanes};
+use crate::wind::raw::{RawField, RawWave};
+use glam::{Mat3, Quat, Vec3, Vec3A, Vec4};
+use rayon::prelude::*;
+
+/// Invocations per cluster in `hsm_clusters.wgsl` (its workgroup size).
+pub const LANES: usize = 64;
+
+#[inline]
+fn v3(a: [f32; 4]) -> Vec3 {
+    Vec3::new(a[0], a[1], a[2])
+}
+
+/// The rotation of `a` (Müller, Bender, Chentanez & Macklin 2016), warm-started from `q`,
+/// with a Newton step. Each of the `iterations` turns `R ← rot(ω) R` by the solution of
+/// `H ω = g`, where `g = Σ rᵢ × aᵢ` is the gradient of `tr(Rᵀ A)` and
+/// `H = tr(B) I − sym(B)`, `B = A Rᵀ`, its Hessian (see [`rotation_step`]). Where `H` is not
+/// safely positive definite (far from the optimum, inverted, collinear or zero clusters)
+/// the step is Müller's `g / (|tr B| + ε)`, with ε 1e-6 of the columns' summed lengths (plus
+/// 1e-30), so every finite `a` leaves a finite rotation, never NaN.
+///
+/// Müller's step alone divides every component of the gradient by `tr B ≈ σ₁ + σ₂ + σ₃`,
+/// while the curvature about a cluster's long axis is only `σ₂ + σ₃`: an elongated cluster
+/// (a leaf blade, a long thin segment) then needs hundreds of iterations to turn about its
+/// axis, and two warm iterations per step left palm fronds up to 1.8 rad from their optimal
+/// rotation. The Newton step converges in one or two.
+///
+/// `rot(ω)` is the unit quaternion along `(ω/2, 1)`: a turn by `2 atan(|ω|/2)` about `ω`,
+/// which is `exp(ω)` to third order (the steps near the optimum are tiny) and shorter far
+/// away, where the iteration only needs to head the right way. It needs no `sin` or `cos`:
+/// Vulkan allows a GPU's `sin` an absolute error of 2⁻¹¹, which is most of a small turn,
+/// and a GPU turning each cluster by a slightly different amount every step drifted from
+/// the CPU by far more than rounding.
+///
+/// The result is a **continuous** function of `a` and `q`: every iteration runs (no early
+/// stop at a threshold) and the two steps are blended, not switched (see
+/// [`rotation_step`]). A threshold turns a rounding difference into a jump of the size of
+/// the threshold, and in a simulation such jumps add up step after step: with them, two
+/// runs started 1e-10 m/s apart ended 1e-5 × the tree's height apart after 1,000 steps,
+/// however small the start's difference (and a GPU, rounding differently, 5e-3).
+pub fn extract_rotation(a: Mat3, q: Quat, iterations: u32) -> Quat {
+    extract_rotations([a], [q], iterations)[0]
+}
+
+/// [`extract_rotation`] of `N` matrices, their iterations in lockstep: the same operations
+/// for each, so the same bits, but `N` independent chains of dependent operations (a
+/// division and a square root each iteration) for the CPU to overlap.
+#[inline(always)]
+pub fn extract_rotations<const N: usize>(a: [Mat3; N], q: [Quat; N], iterations: u32) -> [Quat; N] {
+    let mut q = q;
+    let eps = a.map(|a| 1e-6 * (a.x_axis.length() + a.y_axis.length() + a.z_axis.length()) + 1e-30);
+    for _ in 0..iterations {
+        for k in 0..N {
+            let r = Mat3::from_quat(q[k]);
+            let half = rotation_step(r, a[k], eps[k]) * 0.5;
+            q[k] = (Quat::from_xyzw(half.x, half.y, half.z, 1.0) * q[k]).normalize();
+        }
+    }
+    q
+}
+
+/// One step `ω` of [`extract_rotation`] from rotation `r` toward the rotation of `a`.
+///
+/// `tr(Rᵀ exp(ω̂)ᵀ A) = tr B + ω · g − ½ ωᵀ H ω + O(|ω|³)` with `B = A Rᵀ`,
+/// `g = Σ rᵢ × aᵢ` and `H = tr(B) I − sym(B)`, so the maximum of the quadratic model is at
+/// `ω = H⁻¹ g`. Near the optimum `B` is symmetric with the singular values σ of `A` as
+/// eigenvalues and `H`'s are `σⱼ + σₖ`. The step is `μ + s (H⁻¹ g − μ)` with Müller's
+/// `μ = g / (|tr B| + ε)` and a weight `s = s_near · s_pd ∈ [0, 1]`:
+/// * `s_near` is 1 where `|μ|` is under [`NEWTON_NEAR`] and falls linearly in `|μ|²` to 0 at
+///   twice that (far away the quadratic model can lead Newton to another stationary point;
+///   Müller's step is robust there);
+/// * `s_pd` needs `H` positive definite (Sylvester: `h₀₀ > 0`, the leading 2×2 minor `> 0`,
+///   `det H > 0`) and is `det H / (10⁻⁴ (tr B)³) − 1` clamped to [0, 1], so it is 0 for
+///   clusters thinner than about 1% of their length, whose turn about the long axis is not
+///   determined, and 1 from 2% up. It is continuous: leaving the positive definite set
+///   takes `det H` through 0, where `s_pd` is already 0.
+///
+/// So `ω` is a continuous function of `r` and `a` (see [`extract_rotation`] for why that
+/// matters). WGSL: `rotation_step` in `hsm.wgsl`, the same operations in the same order.
+#[inline(always)]
+pub fn rotation_step(r: Mat3, a: Mat3, eps: f32) -> Vec3 {
+    let g = r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
+    let tr = r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis);
+    let muller = g / (tr.abs() + eps);
+    let near = NEWTON_NEAR * NEWTON_NEAR;
+    let s_near = ((4.0 * near - muller.length_squared()) / (3.0 * near)).min(1.0);
+    if !(tr > 0.0 && s_near > 0.0) {
+        return muller;
+    }
+    // Columns of B = A Rᵀ: bₖ = Σᵢ aᵢ rᵢ[k].
+    let b0 = a.x_axis * r.x_axis.x + a.y_axis * r.y_axis.x + a.z_axis * r.z_axis.x;
+    let b1 = a.x_axis * r.x_axis.y + a.y_axis * r.y_axis.y + a.z_axis * r.z_axis.y;
+    let b2 = a.x_axis * r.x_axis.z + a.y_axis * r.y_axis.z + a.z_axis * r.z_axis.z;
+    let h00 = tr - b0.x;
+    let h11 = tr - b1.y;
+    let h22 = tr - b2.z;
+    let h01 = -0.5 * (b1.x + b0.y);
+    let h02 = -0.5 * (b2.x + b0.z);
+    let h12 = -0.5 * (b2.y + b1.z);
+    // The adjugate of the symmetric H and its determinant.
+    let c00 = h11 * h22 - h12 * h12;
+    let c01 = h02 * h12 - h01 * h22;
+    let c02 = h01 * h12 - h02 * h11;
+    let c11 = h00 * h22 - h02 * h02;
+    let c12 = h01 * h02 - h00 * h12;
+    let c22 = h00 * h11 - h01 * h01;
+    let det = h00 * c00 + h01 * c01 + h02 * c02;
+    let thin = 1e-4 * (tr * tr * tr);
+    if !(h00 > 0.0 && c22 > 0.0 && det > thin) {
+        return muller;
+    }
+    // (tr B)³ can underflow to zero for a vanishing cluster; det H > 0 then decides alone.
+    let s_pd = if thin > 0.0 { (det / thin - 1.0).min(1.0) } else { 1.0 };
+    let newton = Vec3::new(
+        c00 * g.x + c01 * g.y + c02 * g.z,
+        c01 * g.x + c11 * g.y + c12 * g.z,
+        c02 * g.x + c12 * g.y + c22 * g.z,
+    ) / det;
+    muller + (newton - muller) * (s_near * s_pd)
+}
+
+/// Length of Müller's step below which [`rotation_step`] takes Newton's whole, rad (it
+/// blends the two up to twice this).
+pub const NEWTON_NEAR: f32 = 0.05;
+
+/// Largest weight a cluster brings to the mean of its particles' goals (stage 3).
+///
+/// A cluster's weight is `w = k h²`, its rate `k` (1/s²) times the substep squared; a
+/// particle shared by several clusters goes to the `w`-weighted mean of their goals, the
+/// point where their spring forces `m k_c (g_c − x)` balance, and moves `ᾱ = min(1, Σ w)`
+/// of the way there. That clamp keeps Müller's unconditional stability (a particle never
+/// passes its goal). The weights are **not** clamped at 1:
+/// * Clamped (Müller's per-cluster `α = min(1, k h²)`), every cluster stiffer than `1/h²`
+///   had an equal say, so a thick stem held the ring it shares with a twig or a leaf no
+///   better than the twig did, and a joint resisted only about `m r² / h²` (its ring's mass
+///   and lever). The stochastic bush, whose 3 cm stems are ~50× stiffer than that at
+///   240 Hz, lay down in gusty wind: segment ends 2.0 m from rest on a 2.3 m bush.
+/// * A weight passes 1 only up to `k̂ h²`, `k̂` the smallest rate on the cluster's path to
+///   the root ([`crate::methods::hsm::RawHsmCluster::aqq_inv`]'s first w). A cluster pulls
+///   the parent's rings it reaches into (`overlap`) at its own rate, and a thin twig's rate
+///   can be high only because it is light: unbounded, monopodial's laterals dragged its
+///   trunk (tips 3.0 m from rest in `gusty`, 0.24 m clamped). Below 1 nothing changes, so
+///   slender trees (every cluster under `1/h²`) move as before, bit for bit.
+///
+/// `MAX_WEIGHT` only keeps the sums finite: a ratio of 10⁶ between two clusters already
+/// leaves the softer one no say. WGSL: `MAX_WEIGHT` in `hsm.wgsl`.
+pub const MAX_WEIGHT: f32 = 1e6;
+
+/// One slot's terms of a cluster's sums from the particle's displacement `x` (w = mass) and
+/// the cluster's shift at the last substep `sp`: `[m u, m d q.x, m d q.y, m d q.z]` with
+/// `u = x − x⁰ − sp` and `d = u + q = x − c⁰ − sp` (so Apq stays exactly symmetric at
+/// rest). `Σ m q = 0`, so `sp` drops out of Apq; subtracting it keeps the terms at the size
+/// of the cluster instead of its distance from rest (a palm frond's tip travels metres),
+/// and with them their rounding: a GPU that rounds differently then agrees with the CPU
+/// far better (palm, 1,000 steps on an H100: 4.9e-4 × height apart before, 1.9e-5 after).
+/// WGSL: the slot loop of `hsm_clusters.wgsl`.
+#[inline(always)]
+fn slot_terms(x: [f32; 4], sp: Vec3A, s: &RawHsmSlot) -> [Vec3A; 4] {
+    let m = x[3];
+    let u = a3(x) - sp;
+    let q = Vec3A::from_array(s.q);
+    let d = u + q;
+    [u * m, (d * q.x) * m, (d * q.y) * m, (d * q.z) * m]
+}
+
+/// Stage 1, per cluster: centre of mass, Apq, R, the goal transform, the weight `k h²` and
+/// the wind at the centre. Sums run over the particles' displacements from rest
+/// `u = x − x⁰` (the state itself), so a cluster at rest has exactly zero shift and an
+/// exactly symmetric Apq (R = I): still air keeps the rest bit for bit. Bindings: 0 fields,
+/// 1 waves, 2 cluster info, 3 clusters, 4 slots, 5 displacements (w = mass), 6 step,
+/// 7 cluster state (read for R's warm start, written).
+#[allow(clippy::too_many_arguments)]
+pub fn hsm_clusters(
+    fields: &[RawField],
+    waves: &[RawWave],
+    info: &[RawHsmClusterInfo],
+    clusters: &[RawHsmCluster],
+    slots: &[RawHsmSlot],
+    displacement: &[[f32; 4]],
+    step: RawHsmStep,
+    state: &mut [RawHsmClusterState],
+) {
+    hsm_clusters_with(fields, waves, info, clusters, step, state, |c, sp, quarter| {
+        let inf = &info[c];
+        let run = &slots[inf.slot_offset as usize..(inf.slot_offset + inf.slot_count) as usize];
+        cluster_sums(run, displacement, sp, quarter)
+    });
+}
+
+/// Scratch of one chunk of stage 1: a cluster's quarter lanes (see [`cluster_sums`]).
+pub(crate) type Quarter = [[Vec3A; 4]; LANES / 4];
+
+/// [`hsm_clusters`] with each cluster's sums `[Σ m u, Apq columns]` about the shift `sp`
+/// from `sums(cluster, sp, scratch)`, which must add as [`cluster_sums`] does (the CPU's fast
+/// form, [`super::slot_groups`], gives the same bits).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn hsm_clusters_with<S>(
+    fields: &[RawField],
+    waves: &[RawWave],
+    info: &[RawHsmClusterInfo],
+    clusters: &[RawHsmCluster],
+    step: RawHsmStep,
+    state: &mut [RawHsmClusterState],
+    sums: S,
+) where
+    S: Fn(usize, Vec3A, &mut Quarter) -> [Vec3A; 4] + Sync,
+{
+    // One parallel pass: each chunk of clusters gets its shape matching, then the wind at
+    // the new centres (fixed chunks, so the wind's lane groups do not depend on the threads).
+    const CHUNK: usize = 256;
+    let level = crate::simd::level();
+    state.par_chunks_mut(CHUNK).enumerate().for_each(|(k, chunk)| {
+        let base = k * CHUNK;
+        let mut quarter = [[Vec3A::ZERO; 4]; LANES / 4];
+        // Four clusters at a time, their rotations extracted in lockstep.
+        for (g, group) in chunk.chunks_mut(ROTATIONS).enumerate() {
+            let at = base + g * ROTATIONS;
+            let mut apq = [(Mat3::ZERO, Vec3::ZERO); ROTATIONS];
+            for (i, st) in group.iter().enumerate() {
+                // Sums about the last substep's shift (see `slot_terms`).
+                let t = &st.transform;
+                let sp = Vec3A::new(t[0][3], t[1][3], t[2][3]);
+                apq[i] = cluster_apq(&clusters[at + i], sums(at + i, sp, &mut quarter), sp);
+            }
+            // A last, short group is padded with zero matrices (their rotations are unused).
+            let start =
+                std::array::from_fn(|i| group.get(i).map_or(Quat::IDENTITY, |st| Quat::from_array(st.rotation)));
+            let q = extract_rotations(apq.map(|s| s.0), start, step.polar_iterations);
+            for (i, st) in group.iter_mut().enumerate() {
+                finish_cluster(&clusters[at + i], apq[i], q[i], &step, st);
+            }
+        }
+        if !fields.is_empty() {
+            wind_chunk_at(level, fields, waves, &info[base..base + chunk.len()], step.time, chunk);
+        }
+    });
+}
+
+/// Clusters whose rotations stage 1 extracts together (see [`extract_rotations`]).
+const ROTATIONS: usize = 4;
+
+/// Stage 1 for one cluster (one workgroup of `hsm_clusters.wgsl`) up to R: its Apq and the
+/// shift of its centre from rest, from its sums about the last shift `sp`.
+#[inline(always)]
+fn cluster_apq(cl: &RawHsmCluster, sums: [Vec3A; 4], sp: Vec3A) -> (Mat3, Vec3) {
+    let [sm, a0, a1, a2] = sums.map(Vec3::from);
+    let shift = Vec3::from(sp) + sm / cl.mass;
+    // Σ m q = 0, so Σ m (x − c⁰ − sp) qᵀ is Apq = Σ m (x − c) qᵀ.
+    (Mat3::from_cols(a0, a1, a2), shift)
+}
+
+/// Stage 1 for one cluster after R (`q`): the goal transform, the weight `k h²` and the
+/// state, the wind aside.
+#[inline(always)]
+fn finish_cluster(
+    cl: &RawHsmCluster,
+    (apq, shift): (Mat3, Vec3),
+    q: Quat,
+    step: &RawHsmStep,
+    st: &mut RawHsmClusterState,
+) {
+    let cm = v3(cl.rest_cm) + shift;
+    let r = Mat3::from_quat(q);
+    let mut t = r;
+    if step.beta > 0.0 {
+        let aqq_inv = Mat3::from_cols(v3(cl.aqq_inv[0]), v3(cl.aqq_inv[1]), v3(cl.aqq_inv[2]));
+        let a = apq * aqq_inv;
+        let det = a.determinant();
+        if det > 1e-6 {
+            t = a * (step.beta / det.powf(1.0 / 3.0)) + r * (1.0 - step.beta);
+        }
+    }
+    // The cluster's weight k h², past 1 only up to its path's k̂ h² (see `MAX_WEIGHT`).
+    let bound = (cl.aqq_inv[0][3] * step.dt * step.dt).max(1.0);
+    let weight = (cl.rest_cm[3] * step.dt * step.dt).min(bound).min(MAX_WEIGHT);
+    st.cm = [cm.x, cm.y, cm.z, weight];
+    st.rotation = q.to_array();
+    st.transform = [t.x_axis.extend(shift.x).into(), t.y_axis.extend(shift.y).into(), t.z_axis.extend(shift.z).into()];
+    st.wind = [0.0; 4];
+}
+
+/// Lane `t`'s sums as invocation `t` of `hsm_clusters.wgsl` adds them: zero, plus slot `t`,
+/// slot `t + 64`, …; zero for a lane past the slot count.
+#[inline(always)]
+fn lane_sums(run: &[RawHsmSlot], displacement: &[[f32; 4]], sp: Vec3A, t: usize) -> [Vec3A; 4] {
+    let mut acc = [Vec3A::ZERO; 4];
+    if run.len() <= LANES {
+        // At most one slot per lane (most clusters): the same additions without the
+        // strided iterator.
+        if let Some(s) = run.get(t) {
+            for (a, v) in acc.iter_mut().zip(slot_terms(displacement[s.particle as usize], sp, s)) {
+                *a += v;
+            }
+        }
+        return acc;
+    }
+    for s in run.iter().skip(t).step_by(LANES) {
+        for (a, v) in acc.iter_mut().zip(slot_terms(displacement[s.particle as usize], sp, s)) {
+            *a += v;
+        }
+    }
+    acc
+}
+
+#[inline(always)]
+fn add4(a: [Vec3A; 4], b: [Vec3A; 4]) -> [Vec3A; 4] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
+}
+
+/// Stage 1's sums `[Σ m u, Apq columns]` of one cluster's slots `run`, added in the order of
+/// the workgroup in `hsm_clusters.wgsl`: its lanes (see [`lane_sums`]; lanes past the slot
+/// count are zero, so only the next power of two of them take part) are halved, lane `t`
+/// taking lane `t + stride`, down to lane 0. The two widest halvings are done in registers
+/// as each quarter's lane is formed, `(v_t + v_{t+W/2}) + (v_{t+W/4} + v_{t+3W/4})`, and only
+/// the quarter's lanes go through memory: the same additions in the same order, so the same
+/// bits, without writing every slot's terms out and reading them back.
+#[inline(always)]
+pub(crate) fn cluster_sums(
+    run: &[RawHsmSlot],
+    displacement: &[[f32; 4]],
+    sp: Vec3A,
+    quarter: &mut Quarter,
+) -> [Vec3A; 4] {
+    let width = run.len().clamp(1, LANES).next_power_of_two();
+    let lane = |t: usize| lane_sums(run, displacement, sp, t);
+    match width {
+        1 => lane(0),
+        2 => add4(lane(0), lane(1)),
+        _ => {
+            let q = width / 4;
+            for (t, l) in quarter[..q].iter_mut().enumerate() {
+                *l = add4(add4(lane(t), lane(t + 2 * q)), add4(lane(t + q), lane(t + 3 * q)));
+            }
+            let mut stride = q / 2;
+            while stride > 0 {
+                // Invocation t < stride adds lane t + stride to lane t (one barrier per level).
+                for t in 0..stride {
+                    quarter[t] = add4(quarter[t], quarter[t + stride]);
+                }
+                stride /= 2;
+            }
+            quarter[0]
+        }
+    }
+}
+
+dispatch! {
+/// The wind at the centres of one chunk's segment clusters (a leaf feels the wind sampled
+/// for its segment: stage 4 reads it there, and a leaf cluster's stays zero). The WGSL
+/// samples it in the cluster's own invocation; here sixteen centres at a time
+/// ([`crate::wind::lanes`]).
+fn wind_chunk_at(
+    fields: &[RawField],
+    waves: &[RawWave],
+    info: &[RawHsmClusterInfo],
+    time: f32,
+    state: &mut [RawHsmClusterState],
+) {
+    let segments: Vec<usize> = (0..state.len()).filter(|&j| info[j].kind != kind::LEAF).collect();
+    for group in segments.chunks(WIND_LANES) {
+        let centre = |l: usize| v3(state[group[l.min(group.len() - 1)]].cm);
+        let u = wind_lanes(fields, waves, V3::from_lanes(std::array::from_fn(centre)), time);
+        for (l, &j) in group.iter().enumerate() {
+            let w = u.lane(l);
+            state[j].wind = [w.x, w.y, w.z, 0.0];
+        }
+    }
+}
+}
+
+/// A particle's goal as a displacement from rest (xyz) and ᾱ (w): the mean over its
+/// clusters weighted by their `k h²` (see [`hsm_goals`], [`MAX_WEIGHT`]). WGSL:
+/// `hsm_particle_goal` in `hsm_gather.wgsl`.
+#[inline(always)]
+fn particle_goal(i: usize, member_offset: &[u32], member: &[RawHsmMember], state: &[RawHsmClusterState]) -> [f32; 4] {
+    let lo = member_offset[i] as usize;
+    let hi = member_offset[i + 1] as usize;
+    let mut sum = Vec3A::ZERO;
+    let mut wsum = 0.0f32;
+    for m in &member[lo..hi] {
+        let st = &state[m.cluster as usize];
+        sum += goal_displacement(st, Vec3A::from_array(m.q)) * st.cm[3];
+        wsum += st.cm[3];
+    }
+    if wsum > 0.0 { with_xyz(sum / wsum, wsum.min(1.0)) } else { [0.0; 4] }
+}
+
+/// A cluster's goal for rest offset `q`, as a displacement from rest: `(T q − q) + (c − c⁰)`.
+/// WGSL: `hsm_goal_displacement`.
+#[inline(always)]
+fn goal_displacement(st: &RawHsmClusterState, q: Vec3A) -> Vec3A {
+    let t = &st.transform;
+    let tq = a3(t[0]) * q.x + a3(t[1]) * q.y + a3(t[2]) * q.z;
+    let shift = Vec3A::new(t[0][3], t[1][3], t[2][3]);
+    (tq - q) + shift
+}
+
+/// A free particle's new velocity: the pull toward goal `g` (w = ᾱ) from `u` (both
+/// displacements from rest, so `g − u` is the goal minus the position), gravity,
+/// semi-implicit drag toward `wind` with drag factor `kd`, damping. WGSL: `hsm_velocity`.
+#[inline(always)]
+fn particle_velocity(v: Vec3A, g: [f32; 4], u: Vec3A, wind: Vec3A, kd: f32, step: &RawHsmStep) -> Vec3A {
+    let h = step.dt;
+    let gravity = Vec3A::from_array([step.gravity[0], step.gravity[1], step.gravity[2]]);
+    // ᾱ / h as ᾱ · (1 / h): one division per step, not per particle.
+    let mut vel = v + (a3(g) - u) * (g[3] * (1.0 / h)) + gravity * ((1.0 - step.gravity[3]) * h);
+    let rel = wind - vel;
+    let s = h * kd * rel.length();
+    vel += rel * (s / (1.0 + s));
+    vel * step.damping
+}
+
+/// The xyz of a 16-byte record in a 4-wide register.
+#[inline(always)]
+fn a3(x: [f32; 4]) -> Vec3A {
+    Vec3A::from_vec4(Vec4::from_array(x))
+}
+
+/// A record's xyz replaced, w kept.
+#[inline(always)]
+fn with_xyz(v: Vec3A, w: f32) -> [f32; 4] {
+    v.extend(w).to_array()
+}
+
+/// Stage 3, per particle: the mean of its clusters' goals `T_c q + c_c` weighted by their
+/// `w_c = k_c h²`, and `ᾱ = min(1, Σ w_c)` (see [`MAX_WEIGHT`]). Goals are kept as
+/// displacements from rest, `(T q − q) + (c − c⁰)`, so a cluster at rest gives exactly
+/// zero. Bindings: 0 member offsets, 1 members, 2 cluster state, 3 goals.
+pub fn hsm_goals(member_offset: &[u32], member: &[RawHsmMember], state: &[RawHsmClusterState], goal: &mut [[f32; 4]]) {
+    goal.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, g)| {
+        *g = particle_goal(i, member_offset, member, state);
+    });
+}
+
+/// Stage 4, per particle: shape-matching pull, gravity (balanced by the support of a
+/// prestressed tree), drag toward the wind of its `owner` cluster, damping, then the
+/// displacement. Bindings: 0 owners, 1 cluster state, 2 goals, 3 step, 4 displacements,
+/// 5 velocities (w = drag factor, negative for a fixed particle).
+pub fn hsm_integrate(
+    owner: &[u32],
+    state: &[RawHsmClusterState],
+    goal: &[[f32; 4]],
+    step: RawHsmStep,
+    displacement: &mut [[f32; 4]],
+    velocity: &mut [[f32; 4]],
+) {
+    integrate_free(owner, state, step, displacement, velocity, |i| goal[i]);
+}
+
+/// Stages 3 and 4 in one pass per particle: its goal, gathered from its clusters, is read by
+/// no other particle, so it goes straight into the integration instead of through the goal
+/// buffer (Song needs a synchronisation between the two because his goals are scattered
+/// from the clusters). The same operations as [`hsm_goals`] then [`hsm_integrate`], so the
+/// result is bit for bit theirs without the goal buffer's write and re-read. Bindings:
+/// 0 member offsets, 1 members, 2 cluster state, 3 owners, 4 step, 5 displacements,
+/// 6 velocities.
+pub fn hsm_particles(
+    member_offset: &[u32],
+    member: &[RawHsmMember],
+    state: &[RawHsmClusterState],
+    owner: &[u32],
+    step: RawHsmStep,
+    displacement: &mut [[f32; 4]],
+    velocity: &mut [[f32; 4]],
+) {
+    integrate_free(owner, state, step, displacement, velocity, |i| particle_goal(i, member_offset, member, state));
+}
+
+/// Stage 4 over every free particle, its goal from `goal_of` (read from the goal buffer,
+/// or gathered in place by the fused pass).
+#[inline(always)]
+fn integrate_free(
+    owner: &[u32],
+    state: &[RawHsmClusterState],
+    step: RawHsmStep,
+    displacement: &mut [[f32; 4]],
+    velocity: &mut [[f32; 4]],
+    goal_of: impl Fn(usize) -> [f32; 4] + Sync,
+) {
+    // Chunks with a plain loop inside: the per-particle work is small, so a call per
+    // particle would cost as much as the work.
+    const CHUNK: usize = 1024;
+    displacement.par_chunks_mut(CHUNK).zip(velocity.par_chunks_mut(CHUNK)).enumerate().for_each(|(k, (xs, vs))| {
+        let base = k * CHUNK;
+        let owners = &owner[base..base + xs.len()];
+        for (i, ((x, v), o)) in xs.iter_mut().zip(vs.iter_mut()).zip(owners).enumerate() {
+            let kd = v[3];
+            if kd < 0.0 {
+                continue; // fixed
+            }
+            let u = a3(*x);
+            let vel = particle_velocity(a3(*v), goal_of(base + i), u, a3(state[*o as usize].wind), kd, &step);
+            *x = with_xyz(u + vel * step.dt, x[3]);
+            *v = with_xyz(vel, kd);
+        }
+    });
+}
+
+/// Seam rotations per segment: its cluster's R (identity where it has none). Bindings:
+/// 0 segment clusters, 1 cluster state, 2 acc.
+pub fn hsm_pose(segment_cluster: &[u32], state: &[RawHsmClusterState], acc: &mut [[f32; 4]]) {
+    acc.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, a)| {
+        let c = segment_cluster[i];
+        *a = if c == NONE { [0.0, 0.0, 0.0, 1.0] } else { state[c as usize].rotation };
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simd::{Level, detected};
+    use crate::wind::WindScene;
+    use rand::{Rng, SeedableRng};
+
+    /// The workgroup of `hsm_clusters.wgsl`, step by step: 64 lanes, lane `j mod 64` adding
+    /// slot `j`, then the halving over all 64 lanes (zeros included).
+    fn workgroup_sums(run: &[RawHsmSlot], displacement: &[[f32; 4]], sp: Vec3A) -> [Vec3A; 4] {
+        let mut lane = [[Vec3A::ZERO; 4]; LANES];
+        for (j, s) in run.iter().enumerate() {
+            lane[j % LANES] = add4(lane[j % LANES], slot_terms(displacement[s.particle as usize], sp, s));
+        }
+        let mut stride = LANES / 2;
+        while stride > 0 {
+            for t in 0..stride {
+                lane[t] = add4(lane[t], lane[t + stride]);
+            }
+            stride /= 2;
+        }
+        lane[0]
+    }
+
+    /// `cluster_sums` (two halvings in registers, zero lanes skipped) adds exactly as the
+    /// full 64-lane workgroup does: the same bits for 0 to 200 slots, signed zeros and
+    /// magnitudes from 1e-6 to 1e3 included.
+    #[test]
+    fn cluster_sums_add_as_the_workgroup_does() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        let value = |rng: &mut rand_chacha::ChaCha8Rng| match rng.random_range(0..8) {
+            0 => 0.0,
+            1 => -0.0,
+            _ => rng.random_range(-1.0f32..1.0) * 10f32.powi(rng.random_range(-6..4)),
+        };
+        let mut quarter = [[Vec3A::ZERO; 4]; LANES / 4];
+        for count in (0..=200).chain([256, 257]) {
+            let displacement: Vec<[f32; 4]> = (0..count + 3)
+                .map(|_| [value(&mut rng), value(&mut rng), value(&mut rng), rng.random_range(0.01..2.0)])
+                .collect();
+            let run: Vec<RawHsmSlot> = (0..count)
+                .map(|_| RawHsmSlot {
+                    q: [value(&mut rng), value(&mut rng), value(&mut rng)],
+                    particle: rng.random_range(0..displacement.len() as u32),
+                })
+                .collect();
+            let sp = Vec3A::new(value(&mut rng), value(&mut rng), value(&mut rng));
+            let bits = |s: [Vec3A; 4]| s.map(|v| v.to_array().map(f32::to_bits));
+            assert_eq!(
+                bits(cluster_sums(&run, &displacement, sp, &mut quarter)),
+                bits(workgroup_sums(&run, &displacement, sp)),
+                "{count} slots"
+            );
+        }
+    }
+
+    /// The cluster wind compiled for AVX2 (where the CPU has it) and for the baseline gives
+    /// the same bits, at random centres and times, on every wind preset; leaf clusters keep
+    /// zero wind.
+    #[test]
+    fn cluster_wind_is_the_same_at_every_level() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let info: Vec<RawHsmClusterInfo> = (0..300)
+            .map(|i| RawHsmClusterInfo {
+                kind: if i % 7 == 3 { kind::LEAF } else { kind::SEGMENT },
+                ..bytemuck::Zeroable::zeroed()
+            })
+            .collect();
+        for (name, _, _) in crate::wind::PRESETS {
+            let (fields, waves) = WindScene::resolve(name).unwrap().pack();
+            for _ in 0..5 {
+                let time = rng.random_range(0.0..30.0);
+                let state: Vec<RawHsmClusterState> = (0..info.len())
+                    .map(|_| RawHsmClusterState {
+                        cm: [
+                            rng.random_range(-30.0..30.0),
+                            rng.random_range(0.0..25.0),
+                            rng.random_range(-30.0..30.0),
+                            0.5,
+                        ],
+                        ..bytemuck::Zeroable::zeroed()
+                    })
+                    .collect();
+                let run = |level: Level| {
+                    let mut s = state.clone();
+                    wind_chunk_at(level, &fields, &waves, &info, time, &mut s);
+                    s
+                };
+                let base = run(Level::Baseline);
+                for (i, s) in base.iter().enumerate() {
+                    let moving = s.wind[..3].iter().any(|&w| w != 0.0);
+                    assert_eq!(moving, info[i].kind != kind::LEAF, "{name}: cluster {i} wind {:?}", s.wind);
+                }
+                let bits =
+                    |s: &[RawHsmClusterState]| s.iter().flat_map(|c| c.wind.map(f32::to_bits)).collect::<Vec<_>>();
+                assert_eq!(bits(&base), bits(&run(detected())), "{name} at t = {time}");
+            }
+        }
+    }
+}

@@ -1,0 +1,569 @@
+//! Song et al.'s hierarchical shape matching (HSM, §4–5; shape matching after Müller et al.
+//! 2005): every branch segment and every leaf is a **cluster** of particles that keeps its
+//! own shape; clusters overlap head to tail, and force travels through the shared particles.
+//!
+//! # Clusters (§4, Figs. 3–5)
+//! * A **segment cluster** is `rings` rings of `ring_size` particles along the segment
+//!   (ring `j` at `j / (rings − 1)` of its length). Its first ring is *shared*: it is the ring
+//!   of the parent's cluster nearest to the segment's joint (the parent's tail ring for a
+//!   stem's next segment — Song's head-to-tail link). The root's first ring is its own and
+//!   **fixed** (the tree stands in the ground).
+//! * A **leaf cluster** is the nearest ring of its segment's cluster (shared) plus
+//!   `leaf_particles` points on the blade (its tip, then points along an edge).
+//! * Particles are the simulation's proxies, not the bark: a ring's radius is the segment's
+//!   radius but never less than `ring_ratio × length`, because a joint resists bending
+//!   through the lever of its shared ring and a 2 mm twig ring would have none. Mass and
+//!   drag area come from the tree (wood density × volume, leaf areal density × blade area).
+//!
+//! # Layout (§5.1, Figs. 6–9)
+//! [`HsmLayout`] holds Song's four groups as flat arrays shared by the CPU and the GPU:
+//! *tree information* (`RawHsmStep::clusters`, `particles`, `max_children`), *cluster
+//! information* ([`RawHsmClusterInfo`]: kind, source, particle (slot) offset and count),
+//! *cluster data* ([`RawHsmCluster`]: parent, children, rest centre of mass, Aqq⁻¹; and the
+//! per-step [`RawHsmClusterState`]: current centre of mass, R, the goal transform, the
+//! wind), and *particle data* (displacement from rest + mass, velocity + drag factor (or
+//! [`FIXED`]), rest position, owner). The state is kept as displacements `u = x − x⁰`, not
+//! positions: the stages then never read the rest positions (every per-particle byte
+//! counts, the large layouts are memory-bound), and a particle at rest is exactly zero. A cluster's particles are its run of [`RawHsmSlot`]s (particle index and rest
+//! offset `q = x⁰ − c⁰`); each particle lists the clusters it belongs to with its offset in
+//! each ([`RawHsmMember`]), so a particle's goal is a deterministic gather over its
+//! clusters, never a float atomic.
+//!
+//! # The step (Table 1, §5.2's four stages)
+//! 1. `hsm_clusters` (one GPU workgroup per cluster, shared-memory reduction): centre of
+//!    mass `c`, `Apq = Σ m (x − c⁰) qᵀ`, the rotation `R` of `Apq` (see below), the goal
+//!    transform `T = β Â + (1 − β) R` with `Â = Apq Aqq⁻¹ / det^⅓` (Müller's linear blend;
+//!    `β = 0` is pure rotation), the cluster's weight `w = k h²` and the wind at `c`.
+//! 2. Synchronisation: the end of the dispatch.
+//! 3. `hsm_goals` (per particle): over the clusters sharing it, `g_c = T_c q + c_c`; the goal
+//!    is the weighted mean `ĝ = Σ w_c g_c / Σ w_c` with `ᾱ = min(1, Σ w_c)` (Table 1
+//!    steps 3–4 take `Σ α / n`; with n, a ring shared by twenty leaves had its segment's
+//!    hold diluted twentyfold).
+//! 4. `hsm_integrate` (per particle): `v += ᾱ (ĝ − x) / h + h g` (Table 1 steps 5–6; a
+//!    prestressed tree's support cancels g, see [`HsmParams::prestressed`]),
+//!    drag toward the wind `u` sampled at its cluster's centre (a leaf's segment's)
+//!    `v += (u − v) s / (1 + s)`,
+//!    `s = h k_d |u − v|` (semi-implicit, so it never overshoots the air), damping
+//!    `v *= e^{−c h}`, then `x += h v` (step 7).
+//!
+//! Stages 3 and 4 run as one pass by default (`hsm_particles`, see [`HsmParams::fused`]):
+//! the same numbers bit for bit, without the goal buffer.
+//!
+//! The GPU twins (`sylva_gpu::hsm::GpuHsm`) run the same stages over the same buffers, every
+//! substep of a step in one submission.
+//!
+//! **Stiffness** is a rate, not a per-step fraction: a cluster's weight is `w = k h²` with
+//! `k` in 1/s² (from the wood's `E·I/L`, trunk stiffest). Where `Σ w < 1`,
+//! `v += k h (g − x)` is a spring of angular frequency √k integrated by symplectic Euler and
+//! the static sag under gravity (`x − g = g/k`) does not depend on the step; the clamp
+//! `ᾱ ≤ 1` keeps Müller's unconditional stability. The weights themselves may pass 1 (up
+//! to the smallest rate on the cluster's path to the root): a shared particle's goal is
+//! where its clusters' spring forces balance, so a thick stem holds the ring it shares
+//! with a twig or a leaf (see [`crate::methods::hsm::kernels::MAX_WEIGHT`]). What the clamp still
+//! limits: a joint between two clusters that are both stiffer than `1/h²` resists bending
+//! by about `m L² / h²` (its shared particles' mass and lever), less than the wood of
+//! short, thick segments. Such trees bend more than Akagi's beam model says unless the
+//! substeps rise (`docs/PERFORMANCE.md`, "HSM stiffness against the wood's").
+//!
+//! **Rotation**: `R` is extracted by the iterative method of Müller, Bender, Chentanez &
+//! Macklin (2016), warm-started from the last step's R, `R ← rot(ω) R` (the unit
+//! quaternion along `(ω/2, 1)`, no trigonometry), with a Newton step: `ω = H⁻¹ g`,
+//! `g = Σ rᵢ × aᵢ`, `H = tr(B) I − sym(B)`, `B = Apq Rᵀ` (the gradient and Hessian of
+//! `tr(Rᵀ Apq)`), blended toward Müller's `ω = g / (|tr B| + ε)` where `H` is not safely
+//! positive definite (see [`crate::methods::hsm::kernels::rotation_step`]). It yields a rotation for any
+//! finite `Apq` — flat (leaf), collinear, inverted or zero clusters included — never NaN,
+//! and reaches the optimal rotation in 1–2 iterations per step warm, elongated clusters
+//! included, where Müller's step alone turns them about their long axis by only
+//! `(σ₂ + σ₃) / (σ₁ + σ₂ + σ₃)` of the way per iteration. R is a continuous function of
+//! the particles (no threshold switches a step on or off), so rounding differences between
+//! the CPU and a GPU stay rounding-sized (see [`crate::methods::hsm::kernels::extract_rotation`]).
+//!
+//! # Pose
+//! Each segment turns by its cluster's R (the pose seam's accumulated rotation D = R), and
+//! joints follow by forward kinematics, so lengths are kept and the mesh stays connected.
+//! The cluster transform `R (x⁰ − c⁰) + c` of a joint stays within a few millimetres of it
+//! (see the tests).
+
+pub mod kernels;
+pub mod layout;
+pub mod raw;
+pub mod runs;
+pub mod slot_groups;
+
+pub use layout::HsmLayout;
+pub use raw::*;
+
+use super::{Animator, Method, MethodError, MethodOptions, Simulation};
+use crate::model::{NONE, Tree};
+use crate::pose::{Pose, SeamPose};
+use crate::wind::PackedWind;
+use crate::wind::raw::{RawField, RawWave};
+use glam::Vec3;
+use kernels::{hsm_goals, hsm_integrate, hsm_pose};
+use runs::{HsmRuns, avx2_at, hsm_particles_runs};
+use slot_groups::{HsmSlotGroups, hsm_clusters_groups};
+use std::sync::Arc;
+
+/// Largest particles per ring, rings per segment and particles per leaf.
+pub const MAX_PER_CLUSTER: u32 = 64;
+
+/// Parameters of hierarchical shape matching.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct HsmParams {
+    /// Rings per segment cluster, the shared head ring included (≥ 2). Default 2: head and
+    /// tail, Song's Fig. 5.
+    pub rings: u32,
+    /// Particles per ring (≥ 3). Default 4: the fewest that make a ring resist twist as
+    /// well as bending, at Song's cost per cluster (Table 2 has 42–60 particles per
+    /// cluster; the bench sets rings and ring size to match).
+    pub ring_size: u32,
+    /// Smallest ring radius as a fraction of the segment's length. Default 0.25 (see the
+    /// module notes: a joint's bending resistance is the lever of its shared ring).
+    pub ring_ratio: f32,
+    /// How far a segment cluster reaches into its parent: 1 = the parent's ring nearest
+    /// to the joint (Song's head-to-tail link), 2 = the parent's whole segment (all its
+    /// rings). Default 2: a joint then resists bending through the parent's length rather
+    /// than a ring's radius, so a trunk holds its crown up under gravity with few substeps
+    /// (Müller et al. 2005 widen overlapping regions for the same reason).
+    pub overlap: u32,
+    /// Add a cluster per stem over all its rings (Song's global shape matching, Fig. 4).
+    /// Default true: with segment clusters alone, load travels one segment per substep and
+    /// a long stem sags with the square of its segment count.
+    pub stem_clusters: bool,
+    /// Particles on each leaf blade besides the shared ring (≥ 1). Default 2: its tip and
+    /// a point on its edge, enough to give the blade an orientation.
+    pub leaf_particles: u32,
+    /// Scale on every segment cluster's stiffness. Default 1: the wood's own bending
+    /// stiffness (see the module notes on how a cluster's `k` follows from `E·I/L`).
+    pub stiffness_scale: f32,
+    /// Thinnest radius used for a joint's bending stiffness, m (as
+    /// [`super::akagi::AkagiParams::min_radius`]). Default 1.5 mm.
+    pub min_radius: f32,
+    /// Stiffness of leaf clusters, 1/s². Default 900 (30 rad/s): leaves flutter.
+    pub leaf_stiffness: f32,
+    /// Velocity damping rate c, 1/s: `v *= e^{−c h}` each substep. Default 2: a branch
+    /// released in still air rings down within a few seconds, as wood and air damp it
+    /// (damping ratios 0.05–0.3), on top of the aerodynamic damping of the drag.
+    pub damping: f32,
+    /// Drag coefficient of bark (a cylinder in cross-flow ≈ 1.0–1.2). Default 0.8.
+    pub drag: f32,
+    /// Drag coefficient per (one-sided) leaf area. Default 0.05: leaves shelter one
+    /// another (see [`super::akagi::AkagiParams::leaf_drag`]).
+    pub leaf_drag: f32,
+    /// Gravity along −Y, m/s². Default 9.81.
+    pub gravity: f32,
+    /// The tree as generated is its shape *under its own weight*: a support equal and
+    /// opposite to gravity holds every particle, so still air keeps the rest shape exactly.
+    /// Default true: generators draw trees as they stand, and a particle's step toward its
+    /// goal is capped at ᾱ = 1 per substep, which for tall, thin trees is less than wood's —
+    /// bare gravity would sag them (a stem of n segments sags roughly as n² h² g). A support
+    /// that turned with the wood (`−R g`) was tried and rejected: it is not conservative
+    /// and pumps energy into spinning leaves. False applies bare gravity.
+    pub prestressed: bool,
+    /// Müller's linear blend β ∈ [0, 1]: 0 matches rotations only (rigid clusters);
+    /// larger values let clusters shear and stretch. Default 0.
+    pub beta: f32,
+    /// Iterations of the rotation extraction per step (all of them run, so R is a
+    /// continuous function of the particles; see [`crate::methods::hsm::kernels::extract_rotation`]).
+    /// Default 2: warm-started from the last substep, one iteration tracks the motion and
+    /// the second refines it; a cold start (a cluster rotated far in one step) needs up to
+    /// about 20.
+    pub polar_iterations: u32,
+    /// Run stages 3 and 4 as one pass per particle (`hsm_particles`) instead of two
+    /// (`hsm_goals`, then `hsm_integrate` through the goal buffer). Default true: a
+    /// particle's gathered goal is read by no other particle, so the fused pass gives the
+    /// same numbers bit for bit while moving about a quarter fewer bytes per step (see
+    /// `docs/PERFORMANCE.md`). On the CPU the fused pass runs over runs of particles that
+    /// share their clusters, eight to an AVX2 register ([`crate::methods::hsm::runs`]), with
+    /// the same bits again. False runs Song's four stages as published and keeps
+    /// [`HsmState::goal`] up to date (the fused pass leaves it as it was).
+    pub fused: bool,
+    /// Substeps per `step` call. Default 4: 240 Hz at 60 frames/s, where the clusters of
+    /// long, slender trees (aspen, poplar, fir) have weights `k h²` below 1, so their sag
+    /// and sway do not depend on the frame rate. Trees of short, thick segments are stiffer
+    /// than 240 Hz can hold and bend less as substeps rise (module notes, "Stiffness").
+    pub substeps: u32,
+}
+
+impl Default for HsmParams {
+    fn default() -> Self {
+        Self {
+            rings: 2,
+            ring_size: 4,
+            ring_ratio: 0.25,
+            overlap: 2,
+            stem_clusters: true,
+            leaf_particles: 2,
+            stiffness_scale: 1.0,
+            min_radius: 0.0015,
+            leaf_stiffness: 900.0,
+            damping: 2.0,
+            drag: 0.8,
+            leaf_drag: 0.05,
+            gravity: 9.81,
+            prestressed: true,
+            beta: 0.0,
+            polar_iterations: 2,
+            fused: true,
+            substeps: 4,
+        }
+    }
+}
+
+impl HsmParams {
+    /// The cluster sizes of Song's Tables 2 and 3 (42–60 particles per cluster): segment
+    /// clusters of 4 rings of 14 (42 particles of their own, 56 at the root), leaves of 42
+    /// blade particles, no stem clusters (the paper's counts have none), one substep per step
+    /// (the paper's frame is one shape-matching pass).
+    pub fn song_tables() -> Self {
+        Self { rings: 4, ring_size: 14, leaf_particles: 42, stem_clusters: false, substeps: 1, ..Self::default() }
+    }
+}
+
+/// Song's Table 2 (one tree on a GTX 580): clusters, particles, frames per second.
+pub const SONG_TABLE_2: [(usize, usize, f64); 7] = [
+    (5, 300, 2200.0),
+    (15, 900, 1800.0),
+    (67, 3444, 1400.0),
+    (293, 13548, 1000.0),
+    (867, 38772, 670.0),
+    (2230, 99816, 350.0),
+    (4975, 211812, 175.0),
+];
+
+/// Song's Table 3 (ten trees on a GTX 580): clusters, particles, frames per second.
+pub const SONG_TABLE_3: [(usize, usize, f64); 7] = [
+    (50, 3000, 260.0),
+    (150, 9000, 210.0),
+    (670, 34440, 160.0),
+    (2930, 135480, 110.0),
+    (8670, 387720, 70.0),
+    (22300, 998160, 36.0),
+    (49750, 2118120, 17.0),
+];
+
+/// An unusable parameter or a layout beyond its limits.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HsmError {
+    /// A parameter outside its range.
+    #[error("hsm parameter `{field}` = {value}: {expected}")]
+    Param { field: &'static str, value: f32, expected: &'static str },
+    /// The layout would exceed a limit.
+    #[error("hsm layout needs {needed} {what}, more than the limit of {limit}")]
+    TooLarge { what: &'static str, needed: usize, limit: usize },
+}
+
+/// Largest number of particles (and of slots) in one layout: 64 million (≈ 4 GB of state).
+pub const MAX_PARTICLES: usize = 64 << 20;
+
+impl HsmParams {
+    /// Checks every field's range.
+    pub fn check(&self) -> Result<(), HsmError> {
+        let bad = |field, value: f32, expected| Err(HsmError::Param { field, value, expected });
+        if !(2..=MAX_PER_CLUSTER).contains(&self.rings) {
+            return bad("rings", self.rings as f32, "expected 2 to 64");
+        }
+        if !(3..=MAX_PER_CLUSTER).contains(&self.ring_size) {
+            return bad("ring_size", self.ring_size as f32, "expected 3 to 64");
+        }
+        if !(1..=2).contains(&self.overlap) {
+            return bad("overlap", self.overlap as f32, "expected 1 or 2");
+        }
+        if !(1..=MAX_PER_CLUSTER).contains(&self.leaf_particles) {
+            return bad("leaf_particles", self.leaf_particles as f32, "expected 1 to 64");
+        }
+        if !(self.ring_ratio >= 0.0 && self.ring_ratio <= 10.0) {
+            return bad("ring_ratio", self.ring_ratio, "expected 0 to 10");
+        }
+        for (field, k) in [("stiffness_scale", self.stiffness_scale), ("leaf_stiffness", self.leaf_stiffness)] {
+            if !(k.is_finite() && k > 0.0) {
+                return bad(field, k, "expected a positive number");
+            }
+        }
+        if !(self.min_radius.is_finite() && self.min_radius >= 0.0) {
+            return bad("min_radius", self.min_radius, "expected a finite number ≥ 0 (m)");
+        }
+        for (field, v) in [
+            ("damping", self.damping),
+            ("drag", self.drag),
+            ("leaf_drag", self.leaf_drag),
+            ("gravity", self.gravity.abs()),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(field, v, "expected a finite number ≥ 0");
+            }
+        }
+        if !(0.0..=1.0).contains(&self.beta) {
+            return bad("beta", self.beta, "expected 0 to 1");
+        }
+        if !(1..=64).contains(&self.polar_iterations) {
+            return bad("polar_iterations", self.polar_iterations as f32, "expected 1 to 64");
+        }
+        if !(1..=1000).contains(&self.substeps) {
+            return bad("substeps", self.substeps as f32, "expected 1 to 1000");
+        }
+        Ok(())
+    }
+}
+
+/// Simulation state: structure of arrays, particles in layout order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HsmState {
+    /// Displacement from the rest position `x − x⁰` (xyz, m) and mass (w, kg) of each
+    /// particle; [`Hsm::positions`] adds the rest back.
+    pub displacement: Vec<[f32; 4]>,
+    /// Velocity (xyz, m/s) of each particle; w is its drag factor `k_d` (1/m, as in
+    /// [`HsmLayout::rest`]), or [`FIXED`] for a fixed particle.
+    pub velocity: Vec<[f32; 4]>,
+    /// Per-cluster results of the last substep.
+    pub clusters: Vec<RawHsmClusterState>,
+    /// Goal as a displacement from rest (xyz, m) and ᾱ (w) of each particle from the last
+    /// substep.
+    pub goal: Vec<[f32; 4]>,
+    /// Simulated time, s.
+    pub time: f32,
+}
+
+impl HsmState {
+    /// Kinetic energy ½ Σ m v², J.
+    pub fn kinetic_energy(&self) -> f64 {
+        self.displacement
+            .iter()
+            .zip(&self.velocity)
+            .map(|(p, v)| 0.5 * p[3] as f64 * (Vec3::new(v[0], v[1], v[2]).length_squared() as f64))
+            .sum()
+    }
+
+    /// Largest distance of any particle from the same particle in `other`, m.
+    pub fn max_distance(&self, other: &HsmState) -> f32 {
+        self.displacement
+            .iter()
+            .zip(&other.displacement)
+            .map(|(a, b)| (Vec3::new(a[0], a[1], a[2]) - Vec3::new(b[0], b[1], b[2])).length())
+            .fold(0.0, f32::max)
+    }
+}
+
+/// Hierarchical shape matching set up for one tree (or a forest of copies).
+#[derive(Debug, Clone)]
+pub struct Hsm {
+    /// Parameters.
+    pub params: HsmParams,
+    /// Song's linearised tree.
+    pub layout: HsmLayout,
+    /// The layout's particles in runs of shared membership, for the CPU's fused pass.
+    runs: HsmRuns,
+    /// The layout's slots in groups of eight, for the CPU's stage 1.
+    groups: HsmSlotGroups,
+    rest_joints: Vec<[f32; 4]>,
+}
+
+impl Hsm {
+    /// Builds the clusters of every segment and leaf of `tree`.
+    pub fn new(tree: &Tree, params: HsmParams) -> Result<Self, HsmError> {
+        let layout = HsmLayout::new(tree, &params, None)?;
+        Ok(Self::from_layout(tree, params, layout))
+    }
+
+    /// Uses a prepared layout (truncated or a forest).
+    pub fn from_layout(tree: &Tree, params: HsmParams, layout: HsmLayout) -> Self {
+        let rest_joints = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
+        let runs = HsmRuns::new(&layout);
+        let groups = HsmSlotGroups::new(&layout);
+        Self { params, layout, runs, groups, rest_joints }
+    }
+
+    /// The state at rest (without prestress, gravity has yet to sag it: see [`Self::settle`]).
+    /// The same as [`Method::rest_state`], for layouts without their tree at hand.
+    pub fn state_at_rest(&self) -> HsmState {
+        let l = &self.layout;
+        HsmState {
+            displacement: l.mass.iter().map(|m| [0.0, 0.0, 0.0, *m]).collect(),
+            velocity: l
+                .rest
+                .iter()
+                .zip(&l.free)
+                .map(|(r, f)| [0.0, 0.0, 0.0, if *f > 0.0 { r[3] } else { FIXED }])
+                .collect(),
+            clusters: l.clusters.iter().map(RawHsmClusterState::rest).collect(),
+            goal: vec![[0.0; 4]; l.rest.len()],
+            time: 0.0,
+        }
+    }
+
+    /// Bytes a CPU substep moves, counted as [`HsmLayout::bytes_per_step`] counts them: the
+    /// same where the CPU runs the WGSL's shapes, fewer where it runs its fast forms (stage 1
+    /// over groups of slots, [`HsmSlotGroups::bytes_per_pass`], and the fused pass over runs,
+    /// [`HsmRuns::bytes_per_pass`]).
+    pub fn cpu_bytes_per_step(&self) -> usize {
+        let l = &self.layout;
+        if !avx2_at(crate::simd::level()) {
+            return l.bytes_per_step(self.params.fused);
+        }
+        let particles =
+            if self.params.fused { self.runs.bytes_per_pass() } else { l.bytes_per_step(false) - l.stage1_bytes() };
+        self.groups.bytes_per_pass(l) + particles
+    }
+
+    /// The per-substep values the kernels read.
+    pub fn step_params(&self, time: f32, dt: f32) -> RawHsmStep {
+        let p = &self.params;
+        RawHsmStep {
+            gravity: [0.0, -p.gravity, 0.0, if p.prestressed { 1.0 } else { 0.0 }],
+            dt,
+            time,
+            damping: (-p.damping * dt).exp(),
+            beta: p.beta,
+            polar_iterations: p.polar_iterations,
+            clusters: self.layout.info.len() as u32,
+            particles: self.layout.rest.len() as u32,
+            max_children: self.layout.max_children,
+        }
+    }
+
+    /// One substep: the four stages.
+    pub fn substep(&self, fields: &[RawField], waves: &[RawWave], state: &mut HsmState, h: f32) {
+        let l = &self.layout;
+        let step = self.step_params(state.time + h, h);
+        hsm_clusters_groups(fields, waves, l, &self.groups, &state.displacement, step, &mut state.clusters);
+        if self.params.fused {
+            hsm_particles_runs(l, &self.runs, &state.clusters, step, &mut state.displacement, &mut state.velocity);
+        } else {
+            hsm_goals(&l.member_offset, &l.member, &state.clusters, &mut state.goal);
+            hsm_integrate(&l.owner, &state.clusters, &state.goal, step, &mut state.displacement, &mut state.velocity);
+        }
+        state.time = step.time;
+    }
+
+    /// Advances `state` by `dt` seconds in `params.substeps` substeps ([`Method::step`] with
+    /// the wind's packed arrays).
+    pub fn step_packed(&self, fields: &[RawField], waves: &[RawWave], state: &mut HsmState, dt: f32) {
+        let n = self.params.substeps.max(1);
+        let h = dt / n as f32;
+        for _ in 0..n {
+            self.substep(fields, waves, state, h);
+        }
+    }
+
+    /// Steps in still air until the kinetic energy per kilogram falls below `tolerance`
+    /// (J/kg) or `max_steps` pass; returns the steps taken. The settled state is the tree's
+    /// rest under gravity, which wind displaces and damping returns to.
+    pub fn settle(&self, state: &mut HsmState, dt: f32, max_steps: usize, tolerance: f64) -> usize {
+        let total: f64 = self.layout.mass.iter().map(|&m| m as f64).sum();
+        for k in 0..max_steps {
+            self.step_packed(&[], &[], state, dt);
+            if state.kinetic_energy() / total.max(1e-12) < tolerance {
+                return k + 1;
+            }
+        }
+        max_steps
+    }
+
+    /// Particle positions `x⁰ + u` of `state`, m.
+    pub fn positions(&self, state: &HsmState) -> Vec<Vec3> {
+        self.layout
+            .rest
+            .iter()
+            .zip(&state.displacement)
+            .map(|(r, u)| Vec3::new(r[0] + u[0], r[1] + u[1], r[2] + u[2]))
+            .collect()
+    }
+
+    /// Accumulated rotations of the pose seam: each segment's cluster R (identity for
+    /// segments a truncated layout left out).
+    pub fn rotations(&self, state: &HsmState) -> Vec<[f32; 4]> {
+        let mut acc = vec![[0.0f32; 4]; self.layout.segment_cluster.len()];
+        hsm_pose(&self.layout.segment_cluster, &state.clusters, &mut acc);
+        acc
+    }
+
+    /// Where each segment cluster's own transform puts its segment's joint,
+    /// `R (x⁰ − c⁰) + c` (a check on the forward-kinematics pose).
+    pub fn cluster_joints(&self, tree: &Tree, state: &HsmState) -> Vec<Vec3> {
+        (0..tree.segments.len())
+            .map(|i| {
+                let c = self.layout.segment_cluster[i];
+                if c == NONE {
+                    return tree.segments.start[i];
+                }
+                let st = &state.clusters[c as usize];
+                let rest = &self.layout.clusters[c as usize].rest_cm;
+                let r = glam::Quat::from_array(st.rotation);
+                r * (tree.segments.start[i] - Vec3::new(rest[0], rest[1], rest[2]))
+                    + Vec3::new(st.cm[0], st.cm[1], st.cm[2])
+            })
+            .collect()
+    }
+}
+
+impl From<HsmError> for MethodError {
+    fn from(e: HsmError) -> Self {
+        match e {
+            HsmError::Param { field, value, expected } => MethodError::Param {
+                method: "hsm",
+                field: field.into(),
+                value: value.to_string(),
+                expected: expected.into(),
+            },
+            HsmError::TooLarge { what, needed, limit } => MethodError::TooLarge { method: "hsm", what, needed, limit },
+        }
+    }
+}
+
+/// The registry's CPU constructor: hierarchical shape matching on `tree` with `options`.
+pub fn animator(tree: Arc<Tree>, options: &MethodOptions) -> Result<Box<dyn Animator>, MethodError> {
+    let params = options.parse::<HsmParams>("hsm")?;
+    let method = Hsm::new(&tree, params)?;
+    Ok(Simulation::boxed(tree, method))
+}
+
+impl Method for Hsm {
+    type State = HsmState;
+
+    fn name(&self) -> &'static str {
+        "hsm"
+    }
+
+    fn rest_state(&self, _tree: &Tree) -> HsmState {
+        self.state_at_rest()
+    }
+
+    fn step(&self, _tree: &Tree, wind: &PackedWind, state: &mut HsmState, dt: f32) {
+        self.step_packed(&wind.fields, &wind.waves, state, dt);
+    }
+
+    fn time(&self, state: &HsmState) -> f32 {
+        state.time
+    }
+
+    fn seam(&self, tree: &Tree, _wind: &PackedWind, state: &HsmState, out: &mut SeamPose) {
+        out.acc = self.rotations(state);
+        out.joints.resize(out.acc.len(), [0.0; 4]);
+        crate::pose::fk::pose_positions(&tree.segments.parent, &self.rest_joints, &out.acc, &mut out.joints);
+    }
+
+    /// Segments turned by their clusters' rotations, joints by forward kinematics.
+    fn pose(&self, tree: &Tree, _wind: &PackedWind, state: &HsmState) -> Pose {
+        let acc = self.rotations(state);
+        let mut joints = vec![[0.0f32; 4]; acc.len()];
+        crate::pose::fk::pose_positions(&tree.segments.parent, &self.rest_joints, &acc, &mut joints);
+        Pose {
+            start: joints.iter().map(|j| Vec3::new(j[0], j[1], j[2])).collect(),
+            orientation: acc
+                .iter()
+                .zip(&tree.segments.orientation)
+                .map(|(d, q)| glam::Quat::from_array(*d) * *q)
+                .collect(),
+            bezier: None,
+        }
+    }
+
+    fn cluster_centres(&self, state: &HsmState) -> Option<Vec<Vec3>> {
+        Some(state.clusters.iter().map(|c| Vec3::new(c.cm[0], c.cm[1], c.cm[2])).collect())
+    }
+
+    fn particles(&self) -> Option<usize> {
+        Some(self.layout.particle_count())
+    }
+}

@@ -1,0 +1,124 @@
+//! Song's linearised tree as the GPU lays it out (§5.1, Figs. 6–9): `#[repr(C)]` twins of
+//! the structs in `hsm.wgsl`, checked against naga's layout by the GPU crate's tests.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Cluster kinds ([`RawHsmClusterInfo::kind`]).
+pub mod kind {
+    /// A branch segment.
+    pub const SEGMENT: u32 = 0;
+    /// A leaf.
+    pub const LEAF: u32 = 1;
+    /// A whole stem (the global level of Song's Fig. 4).
+    pub const STEM: u32 = 2;
+}
+
+/// Cluster information (Fig. 9), 16 bytes. WGSL: `HsmClusterInfo` in `hsm.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Pod, Zeroable)]
+pub struct RawHsmClusterInfo {
+    /// [`kind::SEGMENT`] or [`kind::LEAF`].
+    pub kind: u32,
+    /// Segment or leaf index in the tree.
+    pub source: u32,
+    /// First slot of the cluster.
+    pub slot_offset: u32,
+    /// Number of slots (particles) of the cluster.
+    pub slot_count: u32,
+}
+
+/// Cluster data that does not change (Fig. 9), 80 bytes. WGSL: `HsmCluster`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawHsmCluster {
+    /// Rest centre of mass c⁰ (xyz), m; w = stiffness (rate) k, 1/s².
+    pub rest_cm: [f32; 4],
+    /// Parent cluster (`u32::MAX` for the root).
+    pub parent: u32,
+    /// First of the cluster's children in [`HsmLayout::children`].
+    pub child_offset: u32,
+    /// Number of child clusters.
+    pub child_count: u32,
+    /// Total mass of the cluster's particles, kg.
+    pub mass: f32,
+    /// Columns of Aqq⁻¹ (xyz; zero where Aqq is singular), 1/(kg·m²). The first column's w
+    /// is the rate bound k̂, 1/s²: the smallest k on the path from the root to this cluster
+    /// (see [`crate::methods::hsm::kernels::MAX_WEIGHT`]); the other two are zero.
+    pub aqq_inv: [[f32; 4]; 3],
+}
+
+/// One particle of a cluster, 16 bytes. WGSL: `HsmSlot`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawHsmSlot {
+    /// Rest offset from the cluster's rest centre of mass, q = x⁰ − c⁰, m.
+    pub q: [f32; 3],
+    /// Particle index.
+    pub particle: u32,
+}
+
+/// One cluster a particle belongs to, with the particle's rest offset in it, 16 bytes
+/// (the particle's side of a [`RawHsmSlot`], so stage 3 reads one record per cluster).
+/// WGSL: `HsmMember`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawHsmMember {
+    /// Rest offset from the cluster's rest centre of mass, q = x⁰ − c⁰, m.
+    pub q: [f32; 3],
+    /// Cluster index.
+    pub cluster: u32,
+}
+
+/// Cluster data written each step (Fig. 9's current CM, A), 96 bytes. WGSL: `HsmClusterState`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawHsmClusterState {
+    /// Current centre of mass (xyz), m; w = the cluster's weight `k h²` this substep.
+    pub cm: [f32; 4],
+    /// Rotation R as a unit quaternion (x, y, z, w), the warm start of the next step.
+    pub rotation: [f32; 4],
+    /// Columns of the goal transform T (xyz); the w components are the centre's shift
+    /// from rest `c − c⁰` (x, y, z), which goals are built from.
+    pub transform: [[f32; 4]; 3],
+    /// Wind velocity at the centre of mass (xyz), m/s.
+    pub wind: [f32; 4],
+}
+
+impl RawHsmClusterState {
+    /// A cluster at rest: at its rest centre of mass, unrotated.
+    pub fn rest(c: &RawHsmCluster) -> Self {
+        Self {
+            cm: [c.rest_cm[0], c.rest_cm[1], c.rest_cm[2], 0.0],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            transform: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]],
+            wind: [0.0; 4],
+        }
+    }
+}
+
+/// Per-substep values and tree information, 48 bytes. WGSL: `HsmStep`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawHsmStep {
+    /// Gravity (xyz), m/s²; w = 1 when prestressed (see [`HsmParams::prestressed`]).
+    pub gravity: [f32; 4],
+    /// Substep h, s.
+    pub dt: f32,
+    /// Time at the end of the substep, s.
+    pub time: f32,
+    /// `e^{−c h}`.
+    pub damping: f32,
+    /// Müller's β.
+    pub beta: f32,
+    /// Most rotation iterations.
+    pub polar_iterations: u32,
+    /// Number of clusters.
+    pub clusters: u32,
+    /// Number of particles.
+    pub particles: u32,
+    /// Largest number of child clusters of any cluster.
+    pub max_children: u32,
+}
+
+/// [`HsmState::velocity`]'s w for a fixed particle (free ones carry their drag factor ≥ 0).
+pub const FIXED: f32 = -1.0;

@@ -1,0 +1,348 @@
+//! Skjermo's step sixteen stems at a time: the fast CPU path.
+//!
+//! `cpu::skjermo::skjermo_step` is the reference (the twin of `skjermo_step.wgsl`, one stem per
+//! invocation). This module computes the same step on groups of sixteen stems held as
+//! structure-of-arrays lanes ([`crate::simd::F32x16`]). At the larger sizes the step is bound
+//! by memory traffic, so a group keeps only what cannot be recomputed cheaply (100 bytes of
+//! constants per stem against the reference's 160) and derives the rest:
+//!
+//! * the parent's curve enters only through its displacement from rest, because a Bézier is
+//!   linear in its control points: `B(P_rest + Δ, a) = B(P_rest, a) + B(Δ, a)`, so the shift of
+//!   the attachment point is `Σ Bⱼ(a) Δⱼ` and the tangent is the rest tangent plus `B'(Δ, a)`,
+//!   both with weights computed from the stored attachment parameter `a`;
+//! * every control point moves by `shift + (F_now − F_rest) · local`, which is exactly zero
+//!   when nothing moved, so still air still reproduces the rest curves bit for bit. Of the
+//!   rest frame only the normal is stored: its tangent and binormal are recomputed by the
+//!   same instructions that built them;
+//! * the legs P1→P2 and P2→P3 are the local legs turned by the current frame, so of the rest
+//!   control points only the tip (where the wind is sampled) is stored;
+//! * `p2_weight^exponent` is computed once per step, not once per stem;
+//! * the parents' state is fetched with AVX2's gather instruction where the CPU has it.
+//!
+//! The wind is sampled on all sixteen lanes at once ([`crate::wind::lanes`]: a polynomial sine,
+//! integer sharpness by repeated multiplication). Results agree with the
+//! reference to rounding (tested), and are identical whatever the thread count (every group is
+//! computed by the same instructions whichever thread runs it) and whatever the instruction
+//! set (`simd.rs`: AVX2 where the CPU has it, tested against the baseline).
+
+use super::{RawSkjermoStem, bezier_d};
+use crate::model::NONE;
+use crate::simd::{Level, dispatch};
+pub use crate::wind::lanes::LANES;
+use crate::wind::lanes::{V, V3, wind_lanes};
+use crate::wind::raw::{RawField, RawWave};
+use glam::Vec3;
+use rayon::prelude::*;
+use std::ops::{Add, Sub};
+
+/// The attachment frame `[T, N, B]` from a curve tangent and an orientation vector, as
+/// `animate::skjermo::frame`.
+#[inline(always)]
+fn frame(tangent: V3, o: V3) -> [V3; 3] {
+    let tan = unit_tangent(tangent);
+    let n = o.sub(tan.scale(o.dot(tan)));
+    // As in `unit_tangent`, the fallback normal (O along the tangent) only where a lane
+    // needs it.
+    let nl = n.length();
+    let n = if nl.cmp_gt(V::splat(1e-6)).all() {
+        n.scale(V::ONE / nl)
+    } else {
+        n.axis_or(tan.any_orthogonal().axis_or(V3::splat(Vec3::X)))
+    };
+    [tan, n, tan.cross(n)]
+}
+
+/// The frame's unit tangent: `axis_or(Y)`, which where every lane is long enough (all but
+/// degenerate groups) is a plain scale by the reciprocal, bit for bit.
+#[inline(always)]
+fn unit_tangent(tangent: V3) -> V3 {
+    let tl = tangent.length();
+    if tl.cmp_gt(V::splat(1e-6)).all() { tangent.scale(V::ONE / tl) } else { tangent.axis_or(V3::splat(Vec3::Y)) }
+}
+
+/// Per-group constants of sixteen stems (padding lanes have no parent and zero sizes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StemLanes {
+    /// Parent stem of each lane (`NONE` for a trunk or a padding lane).
+    pub parent: [u32; LANES],
+    /// Attachment parameter `a` on the parent's curve (0 for a trunk or padding lane, whose
+    /// gathered parent displacements are zero).
+    pub attach: V,
+    /// Rest tangent of the parent's curve at the attachment (a trunk: its own at 0).
+    pub tan_rest: V3,
+    /// Rest attachment frame's normal (its tangent is `tan_rest` normalised and its binormal
+    /// their cross product, both recomputed bit for bit).
+    pub n_rest: V3,
+    /// Control points relative to the attachment in the attachment frame.
+    pub local: [V3; 4],
+    /// Rest tip P3 (where the wind is sampled).
+    pub rest_tip: V3,
+    /// Static bend per (m/s)², rad·s²/m².
+    pub drag: V,
+    /// Arc length, m.
+    pub length: V,
+}
+
+/// Per-group state of sixteen stems: control-point displacements and orientation vectors.
+/// In memory fifteen lanes-of-sixteen, component after component (`delta[0].x` … `orient.z`),
+/// which the AVX2 gather relies on.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[repr(C)]
+pub struct StateLanes {
+    /// Displacements of P0..P3 from rest.
+    pub delta: [V3; 4],
+    /// Orientation vector O handed to children.
+    pub orient: V3,
+}
+
+impl StateLanes {
+    /// One stem's displacement of control point `j`.
+    pub fn delta(&self, lane: usize, j: usize) -> Vec3 {
+        self.delta[j].lane(lane)
+    }
+    /// One stem's orientation vector.
+    pub fn orient(&self, lane: usize) -> Vec3 {
+        self.orient.lane(lane)
+    }
+}
+
+/// Builds the lane groups from the reference's per-stem constants; `rest_orient` gives each
+/// stem's rest orientation vector. Returns the groups and the rest state.
+pub fn build(stems: &[RawSkjermoStem], rest_orient: &[[f32; 4]]) -> (Vec<StemLanes>, Vec<StateLanes>) {
+    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let groups = stems.len().div_ceil(LANES);
+    let mut lanes = Vec::with_capacity(groups);
+    let mut state = Vec::with_capacity(groups);
+    for g in 0..groups {
+        let ks: [Option<usize>; LANES] = std::array::from_fn(|l| Some(g * LANES + l).filter(|&k| k < stems.len()));
+        let parent = ks.map(|k| k.map_or(NONE, |k| stems[k].parent));
+        let attach = ks.map(|k| k.map_or(0.0, |k| if stems[k].parent == NONE { 0.0 } else { stems[k].attach }));
+        let tan = ks.map(|k| {
+            k.map_or(Vec3::ZERO, |k| {
+                let st = &stems[k];
+                if st.parent == NONE {
+                    bezier_d(&st.rest.map(v), 0.0)
+                } else {
+                    bezier_d(&stems[st.parent as usize].rest.map(v), st.attach)
+                }
+            })
+        });
+        let o_rest = ks
+            .map(|k| k.map_or(Vec3::X, |k| if stems[k].parent == NONE { Vec3::X } else { v(stems[k].parent_orient) }));
+        let tan_rest = V3::from_lanes(tan);
+        let f_rest = frame(tan_rest, V3::from_lanes(o_rest));
+        let per =
+            |f: &dyn Fn(&RawSkjermoStem) -> Vec3| V3::from_lanes(ks.map(|k| k.map_or(Vec3::ZERO, |k| f(&stems[k]))));
+        let local = [0, 1, 2, 3].map(|j| per(&|s| v(s.local[j])));
+        let rest_tip = per(&|s| v(s.rest[3]));
+        let scalar = |f: &dyn Fn(&RawSkjermoStem) -> f32| V::from(ks.map(|k| k.map_or(0.0, |k| f(&stems[k]))));
+        lanes.push(StemLanes {
+            parent,
+            attach: V::from(attach),
+            tan_rest,
+            n_rest: f_rest[1],
+            local,
+            rest_tip,
+            drag: scalar(&|s| s.drag),
+            length: scalar(&|s| s.length),
+        });
+        let orient = V3::from_lanes(ks.map(|k| k.map_or(Vec3::ZERO, |k| v(rest_orient[k]))));
+        state.push(StateLanes { delta: [V3::ZERO; 4], orient });
+    }
+    (lanes, state)
+}
+
+/// Floats in one [`StateLanes`].
+const STATE_FLOATS: usize = 15 * LANES;
+const _: () = assert!(std::mem::size_of::<StateLanes>() == STATE_FLOATS * 4);
+
+/// Gathers the parents' previous state for the sixteen lanes of a group (a trunk or padding
+/// lane sees no displacement and the orientation vector `X`, as the reference's trunk frame;
+/// so does a lane whose parent lies outside `prev`, as in [`gather_avx2`]).
+#[inline(always)]
+fn gather(parent: &[u32; LANES], prev: &[StateLanes]) -> ([V3; 4], V3) {
+    let mut d = [[[0.0f32; LANES]; 3]; 4];
+    let mut o = [[1.0f32; LANES], [0.0; LANES], [0.0; LANES]];
+    for (l, &p) in parent.iter().enumerate() {
+        let (g, pl) = (p as usize / LANES, p as usize % LANES);
+        let Some(s) = prev.get(g) else {
+            continue;
+        };
+        for (j, dj) in d.iter_mut().enumerate() {
+            dj[0][l] = s.delta[j].x.as_array_ref()[pl];
+            dj[1][l] = s.delta[j].y.as_array_ref()[pl];
+            dj[2][l] = s.delta[j].z.as_array_ref()[pl];
+        }
+        o[0][l] = s.orient.x.as_array_ref()[pl];
+        o[1][l] = s.orient.y.as_array_ref()[pl];
+        o[2][l] = s.orient.z.as_array_ref()[pl];
+    }
+    let v3 = |a: [[f32; LANES]; 3]| V3 { x: V::from(a[0]), y: V::from(a[1]), z: V::from(a[2]) };
+    ([v3(d[0]), v3(d[1]), v3(d[2]), v3(d[3])], v3(o))
+}
+
+/// [`gather`] with AVX2's gather instruction: fifteen component loads of eight lanes each,
+/// twice, instead of 240 scalar copies (the same values: a gather only moves bits). A parent
+/// at or beyond the end of `prev` is read as none, so no lane reads out of bounds.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(unsafe_code)]
+fn gather_avx2(parent: &[u32; LANES], prev: &[StateLanes]) -> ([V3; 4], V3) {
+    use std::arch::x86_64::*;
+    // `step` checks that every float index fits an i32.
+    let last = (prev.len() * LANES).saturating_sub(1) as i32;
+    let base = prev.as_ptr().cast::<f32>();
+    let mut c = [V::ZERO; 15];
+    c[12] = V::ONE;
+    for h in 0..2 {
+        // SAFETY: AVX2 is enabled for this function. `parent` holds sixteen u32, read as two
+        // unaligned halves of eight. A lane is gathered only where its parent is at most
+        // `last`, so its index `(p / 16) · 240 + p % 16 + 16 · component` lies inside `prev`
+        // (`prev` is `repr(C)` fifteen lanes-of-sixteen per group); other lanes keep `c`'s
+        // defaults. Stores go to `c`'s arrays, eight floats at offset 0 or 8.
+        unsafe {
+            let p = _mm256_loadu_si256(parent.as_ptr().add(8 * h).cast());
+            let inside = _mm256_cmpeq_epi32(_mm256_min_epu32(p, _mm256_set1_epi32(last)), p);
+            let idx = _mm256_add_epi32(
+                _mm256_mullo_epi32(_mm256_srli_epi32::<4>(p), _mm256_set1_epi32(STATE_FLOATS as i32)),
+                _mm256_and_si256(p, _mm256_set1_epi32(LANES as i32 - 1)),
+            );
+            let mask = _mm256_castsi256_ps(inside);
+            for (k, ck) in c.iter_mut().enumerate() {
+                let dst = ck.0.as_mut_ptr().add(8 * h);
+                let v = _mm256_mask_i32gather_ps::<4>(_mm256_loadu_ps(dst), base.add(k * LANES), idx, mask);
+                _mm256_storeu_ps(dst, v);
+            }
+        }
+    }
+    let v3 = |k: usize| V3 { x: c[k], y: c[k + 1], z: c[k + 2] };
+    ([v3(0), v3(3), v3(6), v3(9)], v3(12))
+}
+
+/// A control point's displacement: the attachment's shift plus the frame's change applied to
+/// its local coordinates.
+#[inline(always)]
+fn moved(shift: V3, df: &[V3; 3], l: V3) -> V3 {
+    shift.add(df[0].scale(l.x)).add(df[1].scale(l.y)).add(df[2].scale(l.z))
+}
+
+/// Frame coordinates `l` as a world vector: `F · l`.
+#[inline(always)]
+fn in_frame(f: &[V3; 3], l: V3) -> V3 {
+    f[0].scale(l.x).add(f[1].scale(l.y)).add(f[2].scale(l.z))
+}
+
+/// Step constants: time, and the method's parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LaneStep {
+    /// Time, s.
+    pub time: f32,
+    /// `p2_weight^exponent` (eq. 16).
+    pub p2_factor: f32,
+    /// Largest static bend, rad.
+    pub max_bend: f32,
+}
+
+/// One step for every group: re-attach on the parents' previous curves, sample the wind at
+/// the tips, bend P2 and P3 (eqs. 15–17). Same step as `cpu::skjermo::skjermo_step`.
+/// `level`: the instruction set to run on, [`crate::simd::level`] for the CPU's best (every
+/// level gives the same bits).
+pub fn step(
+    level: Level,
+    fields: &[RawField],
+    waves: &[RawWave],
+    stems: &[StemLanes],
+    prev: &[StateLanes],
+    step: LaneStep,
+    next: &mut [StateLanes],
+) {
+    assert!(
+        prev.len() == stems.len() && next.len() == stems.len(),
+        "skjermo_lanes::step: {} stem groups, {} and {} state groups",
+        stems.len(),
+        prev.len(),
+        next.len()
+    );
+    // The AVX2 gather indexes `prev` in floats with i32.
+    let fast_gather =
+        level.min(crate::simd::detected()) == Level::Avx2 && prev.len() * STATE_FLOATS <= i32::MAX as usize;
+    next.par_chunks_mut(16).zip(stems.par_chunks(16)).for_each(|(out, st)| {
+        groups_at(level, fields, waves, st, prev, step, fast_gather, out);
+    });
+}
+
+dispatch! {
+/// The step for a run of groups; `fast_gather`: fetch the parents with [`gather_avx2`] (set
+/// only where the CPU has AVX2 and the AVX2 level was asked for).
+#[allow(clippy::too_many_arguments)]
+fn groups_at(
+    fields: &[RawField],
+    waves: &[RawWave],
+    stems: &[StemLanes],
+    prev: &[StateLanes],
+    step: LaneStep,
+    fast_gather: bool,
+    next: &mut [StateLanes],
+) {
+    for (out, st) in next.iter_mut().zip(stems) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `fast_gather` is set only at the AVX2 level, which `step` runs only where
+        // the CPU has AVX2.
+        #[allow(unsafe_code)]
+        let (dp, o_now) = if fast_gather { unsafe { gather_avx2(&st.parent, prev) } } else { gather(&st.parent, prev) };
+        #[cfg(not(target_arch = "x86_64"))]
+        let (dp, o_now) = {
+            let _ = fast_gather;
+            gather(&st.parent, prev)
+        };
+        // The attachment point's shift `Σ wⱼ Δⱼ` (Bernstein weights of `a`) and the parent
+        // curve's tangent there, `tan_rest + B'(Δ, a)` with `B'(Δ, a) = Σ eⱼ Δⱼ`,
+        // `e = (−3s², 3s² − 6st, 6st − 3t², 3t²)`. Computed here rather than stored: the
+        // step is bound by memory traffic at the larger sizes.
+        let (t, s) = (st.attach, V::ONE - st.attach);
+        let (ss, st_, tt) = (s * s, s * t, t * t);
+        let w = [ss * s, V::splat(3.0) * ss * t, V::splat(3.0) * s * tt, tt * t];
+        let dw = [V::splat(3.0) * ss, V::splat(6.0) * st_, V::splat(3.0) * tt];
+        let e = [-dw[0], dw[0] - dw[1], dw[1] - dw[2], dw[2]];
+        let (mut shift, mut tan) = (V3::ZERO, st.tan_rest);
+        for (j, dj) in dp.iter().enumerate() {
+            shift = shift.add(dj.scale(w[j]));
+            tan = tan.add(dj.scale(e[j]));
+        }
+        let f_now = frame(tan, o_now);
+        // Written out, not with `array::map` or a closure: neither is inlined into the AVX2
+        // body, and they would run as baseline code.
+        let t_rest = unit_tangent(st.tan_rest);
+        let b_rest = t_rest.cross(st.n_rest);
+        let df = [f_now[0].sub(t_rest), f_now[1].sub(st.n_rest), f_now[2].sub(b_rest)];
+        // P0 and P1 only follow the attachment: written at once, so that fewer values stay
+        // live across the wind.
+        out.delta[0] = moved(shift, &df, st.local[0]);
+        out.orient = f_now[1];
+        let d1 = moved(shift, &df, st.local[1]);
+        out.delta[1] = d1;
+        let d2 = moved(shift, &df, st.local[2]);
+        let d3 = moved(shift, &df, st.local[3]);
+        // Wind at the tip, bend factors (eq. 16), length-keeping update (eq. 17).
+        let w = wind_lanes(fields, waves, st.rest_tip.add(d3), step.time);
+        let u = w.length();
+        let theta = (st.drag * u * u).min(V::splat(step.max_bend));
+        let c = st.length * theta;
+        let bend = u.cmp_gt(V::ZERO) & c.cmp_gt(V::ZERO);
+        let cu = c / bend.blend(u, V::ONE);
+        let b3 = w.scale(cu);
+        let b2 = w.scale(cu * V::splat(step.p2_factor));
+        // The legs P1→P2 and P2→P3 as they are now: the rest legs turned with the frame (the
+        // same vectors as the differences of the moved points, without storing the rest
+        // points; the step is bound by memory traffic at the larger sizes).
+        let l2 = in_frame(&f_now, st.local[2].sub(st.local[1]));
+        let l3 = in_frame(&f_now, st.local[3].sub(st.local[2]));
+        // Each leg turned toward its push and kept at its length: P2 moves by c2, P3 by
+        // c2 + c3.
+        let c2 = l2.add(b2).with_length(l2.length()).sub(l2);
+        let c3 = l3.add(b3).with_length(l3.length()).sub(l3);
+        out.delta[2] = d2.add(V3::select(bend, c2, V3::ZERO));
+        out.delta[3] = d3.add(V3::select(bend, c2.add(c3), V3::ZERO));
+    }
+}
+}

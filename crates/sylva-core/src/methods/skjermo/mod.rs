@@ -1,0 +1,350 @@
+//! Skjermo's Bézier bending (§4): every stem is one cubic Bézier whose control points are
+//! re-attached to the parent's curve and bent by the wind each step.
+//!
+//! Each step, for every stem in parallel (`cpu::skjermo::skjermo_step`):
+//! 1. **Re-attach** (§4.2) on the parent's curve *from the previous step*: P0 at the attachment
+//!    parameter, the frame from the curve's derivative there and the parent's orientation
+//!    vector O (the frame `[T, N, B]` with `N` the part of O normal to T — Sloan's handle
+//!    construction, eq. 8), the stem's rest control points carried by that frame. A trunk
+//!    keeps its base.
+//! 2. **Wind**: the scene's velocity F at the re-attached tip P3.
+//! 3. **Bend** (eqs. 15–17): bend factors `b₃ = c F̂·1^e`, `b₂ = c F̂·(1/3)^e` with the
+//!    published exponent e = 1.8 (configurable), where `c = L θ` scales by the stem's length
+//!    and its static bend `θ = min(max_bend, drag · |F|²)` (drag over stiffness, as in
+//!    Zioma's method); then `P'ᵢ = P'ᵢ₋₁ + |Pᵢ − Pᵢ₋₁| · normalize(Pᵢ − Pᵢ₋₁ + bᵢ)` for
+//!    i = 2, 3, which keeps the control polygon's lengths (P0, P1 stay: the branch grows out
+//!    of its parent).
+//!
+//! Because a stem reads its parent's previous curve, motion reaches level d one step after
+//! level d − 1: **level d lags d steps** behind the trunk (§5); at 60 steps/s a four-level
+//! tree's twigs answer 50 ms late. Buffers ping-pong between steps (GPU and CPU alike).
+//!
+//! Control points are kept as displacements from rest so still air reproduces the rest
+//! curves exactly. The pose's segments turn with their stem's tangent (rest → current, at
+//! the segment's middle) through the pose seam, so lengths are kept and `Pose::bezier`
+//! carries the animated curves for the deformer.
+
+pub mod kernels;
+pub mod lanes;
+pub mod raw;
+
+pub use raw::*;
+
+use self::lanes::{LANES, LaneStep, StateLanes, StemLanes};
+use super::{Animator, Method, MethodError, MethodOptions, Simulation, check};
+use crate::model::{NONE, Tree};
+use crate::pose::{Curves, Pose, SeamPose};
+use crate::wind::PackedWind;
+use crate::wind::raw::{RawField, RawWave};
+use glam::{Vec3, Vec4};
+use kernels::{skjermo_rotations, skjermo_step};
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// Parameters of Skjermo's method.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SkjermoParams {
+    /// Exponent e of eq. 16 (published: 1.8).
+    pub exponent: f32,
+    /// Weight of P2's bend factor before the exponent (printed: 1/3).
+    pub p2_weight: f32,
+    /// Largest static bend of a stem, rad.
+    pub max_bend: f32,
+    /// Drag coefficient of bark and leaves for the static bend (as in Zioma's method).
+    pub drag: f32,
+}
+
+impl Default for SkjermoParams {
+    fn default() -> Self {
+        Self { exponent: 1.8, p2_weight: 1.0 / 3.0, max_bend: 0.6, drag: crate::physics::BRANCH_DRAG }
+    }
+}
+
+/// Skjermo's results (GeForce 7900 GTX): (branches, updates per second) of the wind
+/// animation shader alone, with 256² textures (65,536 branches) and 512² (262,144).
+pub const SKJERMO_FIGURE: [(usize, f64); 2] = [(65_536, 600.0), (262_144, 180.0)];
+
+/// The benchmark's L-system (`sylva bench skjermo`): a binary tree, every stem one segment,
+/// two children at ±30° (16 iterations: 65,535 stems; 18: 262,143).
+pub const BENCH_BINARY_TREE: &str = "axiom: A(1)\nA(l) -> F(l)[+(30)A(l*0.8)][-(30)/(90)A(l*0.8)]\n";
+
+/// The benchmark's wind, the paper's setting: four sines (eqs. 11–14).
+pub const BENCH_FOUR_SINES: &str = "[[field]]\nkind = \"sum_of_sines\"\nsharpness = 2.0\nwaves = [\n\
+    { amplitude = 4.0, direction_deg = 0.0, wavelength = 40.0, speed = 6.0 },\n\
+    { amplitude = 2.0, direction_deg = 30.0, wavelength = 17.0, speed = 4.0 },\n\
+    { amplitude = 1.0, direction_deg = -25.0, wavelength = 9.0, speed = 3.0 },\n\
+    { amplitude = 0.5, direction_deg = 60.0, wavelength = 5.0, speed = 2.0 },\n]\n";
+
+/// Skjermo's method set up for one tree.
+#[derive(Debug, Clone)]
+pub struct Skjermo {
+    /// Parameters.
+    pub params: SkjermoParams,
+    /// Per-stem constants (after editing them, call [`Skjermo::rebuild_lanes`]).
+    pub stems: Vec<RawSkjermoStem>,
+    /// Rest orientation vector of each stem.
+    pub rest_orient: Vec<[f32; 4]>,
+    /// Per-segment (stem, Bézier parameter of the segment's middle).
+    pub segment_param: Vec<[f32; 4]>,
+    /// The per-stem constants in groups of sixteen for the fast CPU step.
+    pub lanes: Vec<StemLanes>,
+    rest_lanes: Vec<StateLanes>,
+}
+
+/// State: per-stem displacements (current), time and the current pose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SkjermoState {
+    /// Per-stem state.
+    pub stems: Vec<RawSkjermoState>,
+    /// Steps taken.
+    pub steps: u64,
+    /// Simulated time, s.
+    pub time: f32,
+    /// Current pose (with Béziers).
+    pub pose: Pose,
+    /// Accumulated rotations D of the current pose (the seam's buffer).
+    pub acc: Vec<[f32; 4]>,
+    /// The per-stem state in groups of sixteen (what the CPU step reads and writes; `stems`
+    /// is copied from it after every step).
+    pub lanes: Vec<StateLanes>,
+    scratch: Vec<StateLanes>,
+}
+
+/// Bézier point.
+pub fn bezier(p: &[Vec3; 4], t: f32) -> Vec3 {
+    let s = 1.0 - t;
+    p[0] * (s * s * s) + p[1] * (3.0 * s * s * t) + p[2] * (3.0 * s * t * t) + p[3] * (t * t * t)
+}
+
+/// Bézier derivative.
+pub fn bezier_d(p: &[Vec3; 4], t: f32) -> Vec3 {
+    let s = 1.0 - t;
+    (p[1] - p[0]) * (3.0 * s * s) + (p[2] - p[1]) * (6.0 * s * t) + (p[3] - p[2]) * (3.0 * t * t)
+}
+
+/// `v` normalised (by one reciprocal) where longer than 1e-6, else `fallback`. WGSL:
+/// `unit_or` in `skjermo.wgsl`; the lane path (`skjermo_lanes`) rounds the same way, so the
+/// rest frames it stores match these bit for bit.
+pub fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
+    let l = v.length();
+    if l > 1e-6 { v * (1.0 / l) } else { fallback }
+}
+
+/// The attachment frame `[T, N, B]` at `t` with orientation vector `o` (columns as arrays).
+pub fn frame(p: &[Vec3; 4], o: Vec3, t: f32) -> [Vec3; 3] {
+    frame_from_tangent(bezier_d(p, t), o)
+}
+
+/// The attachment frame from a curve tangent (not necessarily unit) and an orientation vector.
+pub fn frame_from_tangent(tangent: Vec3, o: Vec3) -> [Vec3; 3] {
+    let tan = unit_or(tangent, Vec3::Y);
+    let n = unit_or(o - tan * o.dot(tan), unit_or(tan.any_orthogonal_vector(), Vec3::X));
+    [tan, n, tan.cross(n)]
+}
+
+fn closest_param(p: &[Vec3; 4], q: Vec3) -> f32 {
+    let mut best = (f32::MAX, 0.0f32);
+    for k in 0..=256 {
+        let t = k as f32 / 256.0;
+        let d = (bezier(p, t) - q).length_squared();
+        if d < best.0 {
+            best = (d, t);
+        }
+    }
+    best.1
+}
+
+impl Skjermo {
+    /// Precomputes rest control points, attachment parameters and frames.
+    pub fn new(tree: &Tree, params: SkjermoParams) -> Self {
+        let st = &tree.stems;
+        let s = &tree.segments;
+        let ctrl = |k: usize| st.bezier[k];
+        let mut stems = Vec::with_capacity(st.len());
+        let mut rest_orient = vec![[0.0f32; 4]; st.len()];
+        for k in 0..st.len() {
+            let p = ctrl(k);
+            let (attach, f) = if st.parent[k] == NONE {
+                let f = frame(&p, Vec3::X, 0.0);
+                (0.0, f)
+            } else {
+                let pk = st.parent[k] as usize;
+                let pp = ctrl(pk);
+                let a = closest_param(&pp, p[0]);
+                let o = Vec3::from_slice(&rest_orient[pk][..3]);
+                (a, frame(&pp, o, a))
+            };
+            // This stem's own orientation vector: its frame's normal, carried with the frame.
+            rest_orient[k] = f[1].extend(0.0).to_array();
+            let base = if st.parent[k] == NONE { p[0] } else { bezier(&ctrl(st.parent[k] as usize), attach) };
+            let local = [0, 1, 2, 3].map(|j| {
+                let d = p[j] - base;
+                Vec4::new(d.dot(f[0]), d.dot(f[1]), d.dot(f[2]), 0.0).to_array()
+            });
+            stems.push(RawSkjermoStem {
+                rest: p.map(|q| q.extend(1.0).to_array()),
+                local,
+                parent: st.parent[k],
+                attach,
+                drag: crate::physics::StemLoad::of(tree, k).bend_per_u2() * params.drag / crate::physics::BRANCH_DRAG,
+                length: st.length[k],
+                parent_orient: if st.parent[k] == NONE { [0.0; 4] } else { rest_orient[st.parent[k] as usize] },
+            });
+        }
+        // Each segment's middle as a parameter on its stem's curve.
+        let segment_param = (0..s.len())
+            .map(|i| {
+                let k = s.stem[i] as usize;
+                let mid = s.start[i] + s.axis(i) * (0.5 * s.length[i]);
+                [f32::from_bits(k as u32), closest_param(&ctrl(k), mid), 0.0, 0.0]
+            })
+            .collect();
+        let (lanes, rest_lanes) = lanes::build(&stems, &rest_orient);
+        Self { params, stems, rest_orient, segment_param, lanes, rest_lanes }
+    }
+
+    /// Rebuilds the fast path's lane groups from `stems` (after editing them).
+    pub fn rebuild_lanes(&mut self) {
+        (self.lanes, self.rest_lanes) = lanes::build(&self.stems, &self.rest_orient);
+    }
+
+    /// Per-step values.
+    pub fn step_params(&self, time: f32) -> RawSkjermoStep {
+        RawSkjermoStep {
+            time,
+            exponent: self.params.exponent,
+            p2_weight: self.params.p2_weight,
+            max_bend: self.params.max_bend,
+            _pad: [0.0; 4],
+        }
+    }
+
+    /// Per-step values of the fast CPU step.
+    pub fn lane_step(&self, time: f32) -> LaneStep {
+        LaneStep { time, p2_factor: self.params.p2_weight.powf(self.params.exponent), max_bend: self.params.max_bend }
+    }
+
+    /// Advances only the stems' curves one step of `dt` seconds (no pose): every stem
+    /// re-attaches to its parent's previous curve and bends; the two lane buffers ping-pong.
+    /// This is the branch update Skjermo's figures count.
+    pub fn step_stems(&self, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
+        let t = state.time + dt;
+        lanes::step(
+            crate::simd::level(),
+            fields,
+            waves,
+            &self.lanes,
+            &state.lanes,
+            self.lane_step(t),
+            &mut state.scratch,
+        );
+        std::mem::swap(&mut state.lanes, &mut state.scratch);
+        state.time = t;
+        state.steps += 1;
+    }
+
+    /// The same step through the reference kernel (`cpu::skjermo::skjermo_step`, the twin of
+    /// the WGSL), one stem at a time, on `state.stems` only; kept to check the fast path
+    /// against.
+    pub fn step_reference(&self, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
+        let t = state.time + dt;
+        let mut next = state.stems.clone();
+        skjermo_step(fields, waves, &self.stems, &state.stems, self.step_params(t), &mut next);
+        state.stems = next;
+        state.time = t;
+        state.steps += 1;
+    }
+
+    /// The pose (segment transforms and animated Béziers) from `state.stems`.
+    pub fn update_pose(&self, tree: &Tree, state: &mut SkjermoState) {
+        let mut delta = vec![[0.0f32; 4]; tree.segments.len()];
+        skjermo_rotations(&self.segment_param, &self.stems, &state.stems, &tree.segments.parent, &mut delta);
+        let (joints, acc) = crate::pose::seam_buffers(tree, &delta);
+        let mut pose = Pose::from_seam(tree, &joints, &acc);
+        state.acc = acc;
+        pose.bezier = Some(
+            self.stems
+                .iter()
+                .zip(&state.stems)
+                .map(|(r, s)| {
+                    [0, 1, 2, 3].map(|j| Vec3::from_slice(&r.rest[j][..3]) + Vec3::from_slice(&s.delta[j][..3]))
+                })
+                .collect(),
+        );
+        state.pose = pose;
+    }
+}
+
+impl SkjermoParams {
+    /// Checks every field's range.
+    pub fn check(&self) -> Result<(), MethodError> {
+        let m = "skjermo";
+        check(m, "exponent", self.exponent, self.exponent > 0.0 && self.exponent <= 16.0, "0 to 16")?;
+        check(m, "p2_weight", self.p2_weight, (0.0..=1.0).contains(&self.p2_weight), "0 to 1")?;
+        check(m, "max_bend", self.max_bend, self.max_bend > 0.0 && self.max_bend <= 3.2, "0 to π rad")?;
+        check(m, "drag", self.drag, self.drag >= 0.0, "a finite number ≥ 0")
+    }
+}
+
+/// The registry's CPU constructor: Skjermo's method on `tree` with `options`.
+pub fn animator(tree: Arc<Tree>, options: &MethodOptions) -> Result<Box<dyn Animator>, MethodError> {
+    let params = options.parse::<SkjermoParams>("skjermo")?;
+    params.check()?;
+    let method = Skjermo::new(&tree, params);
+    Ok(Simulation::boxed(tree, method))
+}
+
+impl Method for Skjermo {
+    type State = SkjermoState;
+
+    fn name(&self) -> &'static str {
+        "skjermo"
+    }
+
+    fn rest_state(&self, tree: &Tree) -> SkjermoState {
+        SkjermoState {
+            stems: self.rest_orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect(),
+            steps: 0,
+            time: 0.0,
+            pose: Pose { bezier: Some(tree.stems.bezier.clone()), ..Pose::rest(tree) },
+            acc: vec![[0.0, 0.0, 0.0, 1.0]; tree.segments.len()],
+            lanes: self.rest_lanes.clone(),
+            scratch: self.rest_lanes.clone(),
+        }
+    }
+
+    /// One step of `dt` seconds: all stems re-attach to their parents' previous curves and
+    /// bend (ping-pong, sixteen stems at a time), then the pose follows.
+    fn step(&self, tree: &Tree, wind: &PackedWind, state: &mut SkjermoState, dt: f32) {
+        self.step_stems(&wind.fields, &wind.waves, state, dt);
+        let lanes = &state.lanes;
+        state.stems.par_iter_mut().enumerate().for_each(|(k, s)| {
+            let g = &lanes[k / LANES];
+            let l = k % LANES;
+            *s = RawSkjermoState {
+                delta: [0, 1, 2, 3].map(|j| g.delta(l, j).extend(0.0).to_array()),
+                orient: g.orient(l).extend(0.0).to_array(),
+            };
+        });
+        self.update_pose(tree, state);
+    }
+
+    fn time(&self, state: &SkjermoState) -> f32 {
+        state.time
+    }
+
+    fn seam(&self, _tree: &Tree, _wind: &PackedWind, state: &SkjermoState, out: &mut SeamPose) {
+        out.joints.clear();
+        out.joints.extend(state.pose.start.iter().map(|p| p.extend(0.0).to_array()));
+        out.acc.clone_from(&state.acc);
+    }
+
+    fn pose(&self, _tree: &Tree, _wind: &PackedWind, state: &SkjermoState) -> Pose {
+        state.pose.clone()
+    }
+
+    fn curves<'a>(&'a self, state: &'a SkjermoState) -> Option<Curves<'a>> {
+        Some(Curves { stems: &self.stems, state: &state.stems })
+    }
+}

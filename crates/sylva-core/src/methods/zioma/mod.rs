@@ -1,0 +1,288 @@
+//! Zioma's procedural wind animation (GPU Gems 3, ch. 6, §6.3–6.5).
+//!
+//! Stateless: the pose at time t is a function of (tree, wind, t) alone.
+//!
+//! * **Trunk** (§6.3.3): the trunk noise bands of [`trunk`] for the wind speed
+//!   at the crown's centre at time t give angles parallel to the wind (about `up × w`),
+//!   perpendicular (about `w`) and a twist (about `up`), spread over the trunk's segments in
+//!   proportion to their length.
+//! * **Branches** (§6.3.3, Listing 6-1): each stem samples the wind at its base. Its
+//!   horizontal direction `b` against the wind direction `w` weighs three cases,
+//!   `facing = max(0, −b·w)`, `back = max(0, b·w)`, `perpendicular = 1 − |b·w|`:
+//!   facing the wind the branch is pressed downwind, toward the trunk, and barely sways;
+//!   on the back side it sways with high amplitude; perpendicular to the wind it bends about
+//!   its parent's axis and twists about its own.
+//! * **Amplitude and stiffness** (Ota 2003): the static bend `θ = τ / k` from the drag torque
+//!   `τ = ½ ρ C_d A U² · L/2` on the stem's bark and leaves against the stiffness of its base
+//!   joint `k = E·I/L`, capped at `max_bend`; sway frequency `f = √(k / (m L²/3)) / 2π`
+//!   (a rod turning about its end), clamped to 0.3–10 Hz.
+//! * **Phase** (§6.3.3): a random phase per stem, from the seed; **inertia**: branches lag
+//!   the trunk by `−inertia · trunk rate / (2π f)`.
+//! * **Hierarchy** (§6.4): per-branch angles become quaternions, concatenated from the root
+//!   down by the pose seam ([`crate::animate`]); **LOD**: trunk only, or trunk and branches.
+
+pub mod raw;
+pub mod rotations;
+pub mod trunk;
+
+pub use raw::*;
+
+use super::{Animator, Method, MethodError, MethodOptions, Simulation, check};
+use crate::model::{NONE, Tree};
+use crate::physics::StemLoad;
+use crate::pose::{Placement, Pose, SeamPose};
+use crate::rng::{child_key, mix64};
+use crate::wind::PackedWind;
+use crate::wind::WindScene;
+use crate::wind::raw::{RawField, RawWave};
+use glam::Vec3;
+use rotations::zioma_rotations;
+use std::sync::Arc;
+use trunk::TrunkNoise;
+
+/// Simulation level of detail (§6.5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Lod {
+    /// Trunk only: branches ride along rigidly.
+    TrunkOnly,
+    /// Trunk and branches.
+    #[default]
+    Full,
+}
+
+/// Parameters of Zioma's method (a scene's `[tree.params]` sets any of them but `seed`,
+/// which is the tree's).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ZiomaParams {
+    /// Simulation LOD.
+    pub lod: Lod,
+    /// Scales every branch angle (1 = physical estimate).
+    pub amplitude: f32,
+    /// Largest static bend of a branch, rad (0.6 ≈ 35°: beyond it a rigid-rotation model
+    /// of a bending branch looks wrong).
+    pub max_bend: f32,
+    /// How strongly branches lag the trunk's motion (0 = not at all).
+    pub inertia: f32,
+    /// Seed of the per-branch phases.
+    #[serde(skip)]
+    pub seed: u64,
+}
+
+impl Default for ZiomaParams {
+    fn default() -> Self {
+        Self { lod: Lod::Full, amplitude: 1.0, max_bend: 0.6, inertia: 0.5, seed: 0 }
+    }
+}
+
+impl ZiomaParams {
+    /// Checks every field's range.
+    pub fn check(&self) -> Result<(), MethodError> {
+        check("zioma", "amplitude", self.amplitude, self.amplitude >= 0.0, "a finite number ≥ 0")?;
+        check("zioma", "max_bend", self.max_bend, self.max_bend > 0.0 && self.max_bend <= 3.2, "0 to π rad")?;
+        check("zioma", "inertia", self.inertia, self.inertia >= 0.0, "a finite number ≥ 0")
+    }
+}
+
+/// Zioma's state: the time alone (the pose is a closed form in t).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ZiomaState {
+    /// Time, s.
+    pub time: f32,
+}
+
+/// The registry's CPU constructor: Zioma's method on `tree` with `options`.
+pub fn animator(tree: Arc<Tree>, options: &MethodOptions) -> Result<Box<dyn Animator>, MethodError> {
+    let params = ZiomaParams { seed: options.seed, ..options.parse::<ZiomaParams>("zioma")? };
+    params.check()?;
+    let method = Zioma::new(&tree, params);
+    Ok(Simulation::boxed(tree, method))
+}
+
+/// Zioma's Table 6-1 (Intel Xeon 2.33 GHz, GeForce 8800 GTX; 4,617 vertices per
+/// instance): (instances, branches, DirectX 9 ms, DirectX 10 ms, two-bone skinning without
+/// branch simulation ms). The DirectX columns are simulation and skinning per frame.
+pub const ZIOMA_TABLE_6_1: [(usize, usize, f64, f64, f64); 4] = [
+    (30, 2_400, 1.46, 1.34, 0.86),
+    (100, 8_000, 3.90, 3.82, 2.32),
+    (256, 20_480, 9.81, 9.68, 5.82),
+    (1_000, 80_000, 38.21, 37.61, 22.48),
+];
+
+/// A placed copy of a tree (§6.5 instancing); see [`Placement`].
+pub type ZiomaInstance = Placement;
+
+/// Zioma's method set up for one tree.
+#[derive(Debug, Clone)]
+pub struct Zioma {
+    /// Parameters.
+    pub params: ZiomaParams,
+    /// Per-stem constants.
+    pub stems: Vec<RawZiomaStem>,
+    /// Point where the trunk's wind is sampled (crown centre), m.
+    pub crown_centre: Vec3,
+    tree_seed: u32,
+    raw: Vec<crate::model::RawSegment>,
+}
+
+impl Zioma {
+    /// Precomputes per-stem drag, frequency and phase.
+    pub fn new(tree: &Tree, params: ZiomaParams) -> Self {
+        let s = &tree.segments;
+        let st = &tree.stems;
+        let key = mix64(params.seed ^ 0x5A10_4D41);
+        let mut stems = Vec::with_capacity(st.len());
+        for k in 0..st.len() {
+            let first = st.first_segment[k] as usize;
+            let load = StemLoad::of(tree, k);
+            let (len, drag) = (load.length, load.bend_per_u2());
+            let freq = load.frequency().clamp(0.3, 10.0);
+            let b = st.bezier[k];
+            let dir = (b[3] - b[0]).try_normalize().unwrap_or(s.axis(first));
+            let parent_axis = if s.parent[first] == NONE { Vec3::Y } else { s.axis(s.parent[first] as usize) };
+            let h = child_key(key, k as u64);
+            stems.push(RawZiomaStem {
+                base: s.start[first].to_array(),
+                drag,
+                dir: dir.to_array(),
+                freq,
+                parent_axis: parent_axis.to_array(),
+                phase: (h >> 40) as f32 / (1u64 << 24) as f32,
+                level: st.level[k] as u32,
+                seed: h as u32,
+                length: len,
+                _pad: 0,
+            });
+        }
+        let (lo, hi) = tree.bounds();
+        let crown_centre = Vec3::new(
+            tree.segments.start.first().map_or(0.0, |p| p.x),
+            0.5 * (lo.y + hi.y) + 0.25 * (hi.y - lo.y),
+            tree.segments.start.first().map_or(0.0, |p| p.z),
+        );
+        Self { params, stems, crown_centre, tree_seed: mix64(params.seed) as u32, raw: tree.raw_segments() }
+    }
+
+    /// The per-frame values at time `t`: wind at the crown, trunk angles and their rate (the
+    /// tree at the origin, unturned).
+    pub fn frame(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], t: f32) -> RawZiomaFrame {
+        self.frame_for(tree, fields, waves, t, None)
+    }
+
+    /// The per-frame values of one instance (`None`: the tree at the origin, unturned).
+    pub fn frame_for(
+        &self,
+        tree: &Tree,
+        fields: &[RawField],
+        waves: &[RawWave],
+        t: f32,
+        instance: Option<&ZiomaInstance>,
+    ) -> RawZiomaFrame {
+        let (centre, seed) = match instance {
+            Some(i) => (i.to_world(self.crown_centre), self.tree_seed ^ i.seed),
+            None => (self.crown_centre, self.tree_seed),
+        };
+        let v = crate::wind::sample::wind_at(fields, waves, centre, t);
+        let v = instance.map_or(v, |i| i.to_local(v));
+        let h = Vec3::new(v.x, 0.0, v.z);
+        let u = h.length();
+        let dir = if u > 1e-6 { h / u } else { Vec3::ZERO };
+        let noise = TrunkNoise::for_tree(tree, u);
+        let a = noise.angles(t, seed);
+        let dt = 0.01;
+        let rate = (noise.angles(t + dt, seed)[0] - noise.angles(t - dt, seed)[0]) / (2.0 * dt);
+        let (sin, cos) = instance.map_or((0.0, 1.0), |i| i.yaw.sin_cos());
+        RawZiomaFrame {
+            wind_dir: dir.to_array(),
+            time: t,
+            trunk: a,
+            trunk_rate: rate,
+            lod: (self.params.lod == Lod::Full) as u32,
+            amplitude: self.params.amplitude,
+            max_bend: self.params.max_bend,
+            inertia: self.params.inertia,
+            origin: instance.map_or([0.0; 3], |i| i.position.to_array()),
+            phase: instance.map_or(0.0, |i| i.phase),
+            heading: [cos, sin],
+            _pad: [0.0; 2],
+        }
+    }
+
+    /// Per-segment rotations δ of every instance at time `t`, instance by instance
+    /// (`instances.len() × segments`), all in one parallel pass (CPU reference).
+    pub fn rotations_instances(
+        &self,
+        tree: &Tree,
+        fields: &[RawField],
+        waves: &[RawWave],
+        t: f32,
+        instances: &[ZiomaInstance],
+    ) -> Vec<[f32; 4]> {
+        let frames: Vec<RawZiomaFrame> =
+            instances.iter().map(|i| self.frame_for(tree, fields, waves, t, Some(i))).collect();
+        let mut out = vec![[0.0; 4]; tree.segments.len() * instances.len()];
+        zioma_rotations(fields, waves, &self.raw, &self.stems, &frames, &mut out);
+        out
+    }
+
+    /// Per-segment rotations δ at time `t` (CPU reference).
+    pub fn rotations(&self, tree: &Tree, wind: &WindScene, t: f32) -> Vec<[f32; 4]> {
+        let (fields, waves) = wind.pack();
+        self.rotations_packed(tree, &fields, &waves, t)
+    }
+
+    /// [`Self::rotations`] with a scene packed once by the caller.
+    pub fn rotations_packed(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], t: f32) -> Vec<[f32; 4]> {
+        let frame = self.frame(tree, fields, waves, t);
+        let mut out = vec![[0.0; 4]; tree.segments.len()];
+        zioma_rotations(fields, waves, &self.raw, &self.stems, &[frame], &mut out);
+        out
+    }
+
+    /// The pose at time `t` (CPU reference).
+    pub fn pose_at(&self, tree: &Tree, wind: &PackedWind, t: f32) -> Pose {
+        Pose::from_rotations(tree, &self.rotations_packed(tree, &wind.fields, &wind.waves, t))
+    }
+}
+
+impl Method for Zioma {
+    type State = ZiomaState;
+
+    fn name(&self) -> &'static str {
+        "zioma"
+    }
+
+    fn rest_state(&self, _tree: &Tree) -> ZiomaState {
+        ZiomaState::default()
+    }
+
+    fn step(&self, _tree: &Tree, _wind: &PackedWind, state: &mut ZiomaState, dt: f32) {
+        state.time += dt;
+    }
+
+    fn time(&self, state: &ZiomaState) -> f32 {
+        state.time
+    }
+
+    fn seam(&self, tree: &Tree, wind: &PackedWind, state: &ZiomaState, out: &mut SeamPose) {
+        *out = SeamPose::from_rotations(tree, &self.rotations_packed(tree, &wind.fields, &wind.waves, state.time));
+    }
+
+    fn pose(&self, tree: &Tree, wind: &PackedWind, state: &ZiomaState) -> Pose {
+        self.pose_at(tree, wind, state.time)
+    }
+
+    fn seam_instances(
+        &self,
+        tree: &Tree,
+        wind: &PackedWind,
+        state: &ZiomaState,
+        instances: &[Placement],
+        out: &mut SeamPose,
+    ) -> bool {
+        let delta = self.rotations_instances(tree, &wind.fields, &wind.waves, state.time, instances);
+        *out = SeamPose::from_rotations(tree, &delta);
+        true
+    }
+}

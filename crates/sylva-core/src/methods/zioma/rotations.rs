@@ -1,0 +1,90 @@
+//! CPU twin of `shader/zioma_rotations.wgsl`: Zioma's per-segment rotations
+//! (see [`crate::methods::zioma`]). Bindings: 0 fields, 1 waves, 2 segments, 3 stems,
+//! 4 frames (one per instance), 5 δ (instance-major: `instance × segments + segment`).
+
+use crate::methods::zioma::{RawZiomaFrame, RawZiomaStem};
+use crate::model::RawSegment;
+use crate::wind::noise::value_noise;
+use crate::wind::raw::{RawField, RawWave};
+use crate::wind::sample::wind_at;
+use glam::{Quat, Vec3};
+use rayon::prelude::*;
+
+/// Unit axis or a fallback when the vector vanishes.
+#[inline]
+pub fn axis_or(v: Vec3, fallback: Vec3) -> Vec3 {
+    let l = v.length();
+    if l > 1e-6 { v / l } else { fallback }
+}
+
+/// Rotation of segment `s`.
+pub fn zioma_rotation(
+    fields: &[RawField],
+    waves: &[RawWave],
+    s: &RawSegment,
+    stem: &RawZiomaStem,
+    f: &RawZiomaFrame,
+) -> Quat {
+    let frac = s.length / stem.length;
+    let up = Vec3::Y;
+    if s.level == 0 {
+        let w = Vec3::from_array(f.wind_dir);
+        let par_axis = axis_or(up.cross(w), Vec3::X);
+        let perp_axis = axis_or(w, Vec3::Z);
+        return Quat::from_axis_angle(par_axis, f.trunk[0] * frac)
+            * Quat::from_axis_angle(perp_axis, f.trunk[1] * frac)
+            * Quat::from_axis_angle(up, f.trunk[2] * frac);
+    }
+    if f.lod == 0 {
+        return Quat::IDENTITY;
+    }
+    // The wind at the stem's base in the world, turned into the tree's frame.
+    let b = Vec3::from_array(stem.base);
+    let (hc, hs) = (f.heading[0], f.heading[1]);
+    let world = Vec3::from_array(f.origin) + Vec3::new(hc * b.x + hs * b.z, b.y, -hs * b.x + hc * b.z);
+    let vw = wind_at(fields, waves, world, f.time);
+    let v = Vec3::new(hc * vw.x - hs * vw.z, vw.y, hs * vw.x + hc * vw.z);
+    let vh = Vec3::new(v.x, 0.0, v.z);
+    let u = vh.length();
+    if u < 1e-6 {
+        return Quat::IDENTITY;
+    }
+    let w = vh / u;
+    let dir = Vec3::from_array(stem.dir);
+    let pa = Vec3::from_array(stem.parent_axis);
+    let bh = Vec3::new(dir.x, 0.0, dir.z);
+    let c = if bh.length() > 1e-4 { bh.normalize().dot(w) } else { 0.0 };
+    let facing = (-c).max(0.0);
+    let back = c.max(0.0);
+    let perp = 1.0 - c.abs();
+    let theta = (stem.drag * u * u).min(f.max_bend) * f.amplitude;
+    let phase = stem.phase + f.phase;
+    let osc = value_noise(stem.freq * f.time + phase, stem.seed);
+    let osc2 = value_noise(2.7 * stem.freq * f.time + phase, stem.seed ^ 0x55);
+    let inertia = -f.inertia * f.trunk_rate / (std::f32::consts::TAU * stem.freq);
+    let bend = theta * (facing * (0.9 + 0.1 * osc) + back * (0.4 + 0.8 * osc) + perp * (0.6 + 0.3 * osc))
+        + inertia * f.amplitude;
+    let k = axis_or(dir.cross(w), axis_or(up.cross(w), Vec3::X));
+    let side = if pa.cross(dir).dot(w) >= 0.0 { 1.0 } else { -1.0 };
+    let swing = side * perp * theta * (0.5 + 0.5 * osc2);
+    let twist = perp * theta * 0.3 * osc2;
+    Quat::from_axis_angle(k, bend * frac)
+        * Quat::from_axis_angle(pa, swing * frac)
+        * Quat::from_axis_angle(dir, twist * frac)
+}
+
+/// The kernel's CPU twin.
+pub fn zioma_rotations(
+    fields: &[RawField],
+    waves: &[RawWave],
+    segments: &[RawSegment],
+    stems: &[RawZiomaStem],
+    frames: &[RawZiomaFrame],
+    out: &mut [[f32; 4]],
+) {
+    let n = segments.len();
+    out.par_iter_mut().enumerate().with_min_len(64).for_each(|(i, o)| {
+        let s = &segments[i % n];
+        *o = zioma_rotation(fields, waves, s, &stems[s.stem as usize], &frames[i / n]).to_array();
+    });
+}

@@ -1,0 +1,74 @@
+//! The tree as a mechanical body, shared by every method: air, drag coefficients, the
+//! mechanical radius of a joint and the loads a stem carries. Methods keep their papers'
+//! mechanisms and take their constants from here.
+
+use crate::model::Tree;
+
+/// Air density at sea level, kg/m³.
+pub const AIR_DENSITY: f32 = 1.225;
+
+/// Drag coefficient of bark and leaves together (a cylinder in cross-flow ≈ 1.0–1.2;
+/// leaves streamline in wind, lowering it).
+pub const BRANCH_DRAG: f32 = 0.8;
+
+/// Mechanical radius of each segment, m: its own base radius, but never thinner than
+/// `min_radius` nor than the radius whose section equals its children's together
+/// (Leonardo's rule — a joint carries what grows beyond it). Generators taper radii for
+/// looks; the mechanics of Akagi's joints and HSM's clusters need this.
+pub fn mechanical_radii(tree: &Tree, min_radius: f32) -> Vec<f32> {
+    let s = &tree.segments;
+    let mut r = vec![0.0f32; s.len()];
+    for i in (0..s.len()).rev() {
+        let carried: f32 = tree.children.of(i).iter().map(|&c| r[c as usize].powi(2)).sum();
+        r[i] = s.radius_base[i].max(min_radius).max(carried.sqrt());
+    }
+    r
+}
+
+/// What one stem carries, as a rod turning about its base joint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StemLoad {
+    /// Area facing the wind: bark (2 r̄ L per segment) and leaf blades (π/4 · w · l), m².
+    pub area: f32,
+    /// Wood and leaf mass of the stem's own segments, kg.
+    pub mass: f32,
+    /// Arc length (never under 0.1 mm), m.
+    pub length: f32,
+    /// Rotational stiffness of the base joint `E·I/L` (never under 1e-9), N·m/rad.
+    pub stiffness: f32,
+}
+
+impl StemLoad {
+    /// The load of stem `k` of `tree`.
+    pub fn of(tree: &Tree, k: usize) -> Self {
+        let s = &tree.segments;
+        let st = &tree.stems;
+        let first = st.first_segment[k] as usize;
+        let n = st.segment_count[k] as usize;
+        let (mut area, mut mass) = (0.0f32, 0.0f32);
+        for i in first..first + n {
+            area += (s.radius_base[i] + s.radius_tip[i]) * s.length[i];
+            mass += s.mass[i];
+            let (o, c) = (tree.children.leaf_offset[i] as usize, tree.children.leaf_count[i] as usize);
+            for l in o..o + c {
+                let a = std::f32::consts::FRAC_PI_4 * tree.leaves.width[l] * tree.leaves.length[l];
+                area += a;
+                mass += a * tree.wood.leaf_areal_density;
+            }
+        }
+        Self { area, mass, length: st.length[k].max(1e-4), stiffness: s.stiffness[first].max(1e-9) }
+    }
+
+    /// Static bend per (m/s)² of wind, rad·s²/m²: the drag torque `½ ρ C_d A U² · L/2` with
+    /// [`BRANCH_DRAG`] over the stiffness (Ota 2003's `θ = τ / k`).
+    pub fn bend_per_u2(&self) -> f32 {
+        let torque_per_u2 = 0.5 * AIR_DENSITY * BRANCH_DRAG * self.area * 0.5 * self.length;
+        torque_per_u2 / self.stiffness
+    }
+
+    /// Sway frequency of the stem as a rod turning about its end, `√(k / (m L²/3)) / 2π`,
+    /// Hz (unclamped).
+    pub fn frequency(&self) -> f32 {
+        (self.stiffness / (self.mass.max(1e-6) * self.length * self.length / 3.0)).sqrt() / std::f32::consts::TAU
+    }
+}

@@ -1,0 +1,195 @@
+//! Per-frame meshing on the GPU: `mesh_tubes.wgsl` (then `mesh_detail.wgsl` for the
+//! midpoints of subdivided bands) and `mesh_leaves.wgsl` write vertex
+//! buffers the renderer draws directly (no CPU round trip per frame), from the pose seam's
+//! buffers — a GPU method's [`crate::pose::GpuPose`], or a CPU pose uploaded each frame.
+//! [`skin`] poses a static rest mesh (Zioma §6.5), [`deform`] bends Skjermo's grid (§3).
+//! The topology ([`MeshLayout`]: rings, index buffers) is uploaded once.
+
+pub mod deform;
+pub mod skin;
+
+use crate::kernel::{Kernel, output, read_back, upload};
+use crate::{GpuContext, GpuError};
+use std::sync::Arc;
+use sylva_core::Tree;
+use sylva_core::mesh::{MeshFrame, MeshLayout, RawVertex};
+use sylva_core::pose::{SeamPose, pose_buffers};
+use sylva_core::pose::Pose;
+use wgpu::util::DeviceExt;
+
+/// One tree's mesh on the GPU: static topology, per-frame vertex buffers.
+#[derive(Debug)]
+pub struct GpuMesh {
+    tubes: Arc<Kernel>,
+    detail_kernel: Arc<Kernel>,
+    leaves_kernel: Arc<Kernel>,
+    info: wgpu::Buffer,
+    rings: wgpu::Buffer,
+    details: wgpu::Buffer,
+    segments: wgpu::Buffer,
+    leaves: wgpu::Buffer,
+    /// Pose buffers used when the pose comes from the CPU.
+    joint: wgpu::Buffer,
+    acc: wgpu::Buffer,
+    /// Bark vertices (storage + vertex buffer).
+    pub tube_vertices: wgpu::Buffer,
+    /// Bark triangle indices.
+    pub tube_indices: wgpu::Buffer,
+    /// Leaf vertices (storage + vertex buffer).
+    pub leaf_vertices: wgpu::Buffer,
+    /// Leaf triangle indices.
+    pub leaf_indices: wgpu::Buffer,
+    /// Number of bark indices.
+    pub tube_index_count: u32,
+    /// Number of leaf indices.
+    pub leaf_index_count: u32,
+    tube_vertex_count: usize,
+    leaf_vertex_count: usize,
+    ring_count: usize,
+    detail_count: usize,
+    leaf_count: usize,
+    segment_count: usize,
+}
+
+pub(crate) fn vertex_buffer(ctx: &GpuContext, label: &'static str, len: usize) -> Result<wgpu::Buffer, GpuError> {
+    let bytes = (len * std::mem::size_of::<RawVertex>()).max(32) as u64;
+    let limit = ctx.device.limits().max_storage_buffer_binding_size;
+    if bytes > limit {
+        return Err(GpuError::TooLarge { what: label, bytes, limit });
+    }
+    Ok(ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    }))
+}
+
+pub(crate) fn index_buffer(ctx: &GpuContext, label: &'static str, indices: &[u32]) -> wgpu::Buffer {
+    let mut data = indices.to_vec();
+    if data.is_empty() {
+        data.push(0);
+    }
+    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(&data),
+        usage: wgpu::BufferUsages::INDEX,
+    })
+}
+
+impl GpuMesh {
+    /// Uploads the topology of `layout`.
+    pub fn new(ctx: &GpuContext, layout: &MeshLayout) -> Result<Self, GpuError> {
+        let n = layout.segments.len();
+        Ok(Self {
+            tubes: Kernel::get(ctx, "mesh_tubes"),
+            detail_kernel: Kernel::get(ctx, "mesh_detail"),
+            leaves_kernel: Kernel::get(ctx, "mesh_leaves"),
+            info: upload(ctx, "mesh info", &[layout.info()])?,
+            rings: upload(ctx, "rings", &layout.rings)?,
+            details: upload(ctx, "mesh details", &layout.details)?,
+            segments: upload(ctx, "mesh segments", &layout.segments)?,
+            leaves: upload(ctx, "mesh leaves", &layout.leaves)?,
+            joint: output::<[f32; 4]>(ctx, "mesh joints", n)?,
+            acc: output::<[f32; 4]>(ctx, "mesh rotations", n)?,
+            tube_vertices: vertex_buffer(ctx, "tube vertices", layout.tube_vertex_count())?,
+            tube_indices: index_buffer(ctx, "tube indices", &layout.tube_indices),
+            leaf_vertices: vertex_buffer(ctx, "leaf vertices", layout.leaf_vertex_count())?,
+            leaf_indices: index_buffer(ctx, "leaf indices", &layout.leaf_indices),
+            tube_index_count: layout.tube_indices.len() as u32,
+            leaf_index_count: layout.leaf_indices.len() as u32,
+            tube_vertex_count: layout.tube_vertex_count(),
+            leaf_vertex_count: layout.leaf_vertex_count(),
+            ring_count: layout.rings.len(),
+            detail_count: layout.details.len(),
+            leaf_count: layout.leaves.len(),
+            segment_count: n,
+        })
+    }
+
+    /// Records the vertex kernels reading the pose from `joint` and `acc` (a GPU method's
+    /// [`crate::pose::GpuPose::joints_buffer`] and [`crate::pose::GpuPose::acc_buffer`]).
+    pub fn record(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        joint: &wgpu::Buffer,
+        acc: &wgpu::Buffer,
+    ) {
+        if self.ring_count > 0 {
+            self.tubes.record(
+                ctx,
+                encoder,
+                &[&self.info, &self.rings, &self.segments, joint, acc, &self.tube_vertices],
+                self.ring_count as u32,
+            );
+        }
+        if self.detail_count > 0 {
+            self.detail_kernel.record(
+                ctx,
+                encoder,
+                &[&self.info, &self.details, &self.tube_vertices],
+                self.detail_count as u32,
+            );
+        }
+        if self.leaf_count > 0 {
+            self.leaves_kernel.record(
+                ctx,
+                encoder,
+                &[&self.info, &self.leaves, &self.segments, joint, acc, &self.leaf_vertices],
+                self.leaf_count as u32,
+            );
+        }
+    }
+
+    /// Uploads a CPU pose and records the vertex kernels on it.
+    pub fn record_pose(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, tree: &Tree, pose: &Pose) {
+        let (joint, acc) = pose_buffers(tree, pose);
+        debug_assert_eq!(joint.len(), self.segment_count);
+        ctx.queue.write_buffer(&self.joint, 0, bytemuck::cast_slice(&joint));
+        ctx.queue.write_buffer(&self.acc, 0, bytemuck::cast_slice(&acc));
+        self.record(ctx, encoder, &self.joint, &self.acc);
+    }
+
+    /// Uploads the seam's buffers of a pose made on the CPU (one instance) and records the
+    /// meshing kernels on them.
+    pub fn record_seam(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, seam: &SeamPose) {
+        debug_assert_eq!(seam.joints.len(), self.segment_count);
+        ctx.queue.write_buffer(&self.joint, 0, bytemuck::cast_slice(&seam.joints));
+        ctx.queue.write_buffer(&self.acc, 0, bytemuck::cast_slice(&seam.acc));
+        self.record(ctx, encoder, &self.joint, &self.acc);
+    }
+
+    /// Meshes a CPU pose and reads the vertices back (tests, exporters).
+    pub fn mesh(&self, ctx: &GpuContext, tree: &Tree, pose: &Pose) -> Result<MeshFrame, GpuError> {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.record_pose(ctx, &mut encoder, tree, pose);
+        ctx.queue.submit([encoder.finish()]);
+        self.read(ctx)
+    }
+
+    /// What the renderer draws: this mesh once per instance of `instances`.
+    pub fn draw_item<'a>(&'a self, instances: &'a wgpu::Buffer, instance_count: u32) -> crate::render::DrawItem<'a> {
+        let buffers = |vertices, indices, index_count| crate::render::MeshBuffers {
+            vertices,
+            indices,
+            index_count,
+            per_instance_vertices: 0,
+        };
+        crate::render::DrawItem {
+            bark: buffers(&self.tube_vertices, &self.tube_indices, self.tube_index_count),
+            leaves: buffers(&self.leaf_vertices, &self.leaf_indices, self.leaf_index_count),
+            instances,
+            first_instance: 0,
+            instance_count,
+        }
+    }
+
+    /// Reads the current vertices back.
+    pub fn read(&self, ctx: &GpuContext) -> Result<MeshFrame, GpuError> {
+        Ok(MeshFrame {
+            tubes: read_back(ctx, &self.tube_vertices, self.tube_vertex_count)?,
+            leaves: read_back(ctx, &self.leaf_vertices, self.leaf_vertex_count)?,
+        })
+    }
+}

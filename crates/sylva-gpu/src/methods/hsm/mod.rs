@@ -1,0 +1,298 @@
+//! Hierarchical shape matching on the GPU (Song §5.2): the four stages as compute kernels
+//! over the same linearised buffers as the CPU ([`sylva_core::methods::hsm::HsmLayout`]),
+//! every substep of a step (and the pose) recorded into one command submission. The state
+//! stays on the GPU; read it back with [`GpuHsm::read_state`] or [`GpuHsm::read_pose`].
+//!
+//! Stage 1 `hsm_clusters` runs one 64-invocation workgroup per cluster with a shared-memory
+//! reduction; stage 2, the synchronisation, is the boundary between dispatches; stage 3
+//! `hsm_goals` and stage 4 `hsm_integrate` run one invocation per particle, or fused as
+//! `hsm_particles` ([`sylva_core::methods::hsm::HsmParams::fused`]). Each substep's
+//! parameters (its time) are copied into the step buffer by a copy command between
+//! substeps, so one submission carries every substep.
+
+use super::{BuildError, GpuAnimator};
+use crate::kernel::{Kernel, output, upload};
+use crate::pose::GpuPose;
+use crate::wind::GpuWind;
+use crate::{GpuContext, GpuError};
+use glam::Vec3;
+use std::sync::Arc;
+use sylva_core::Tree;
+use sylva_core::methods::MethodOptions;
+use sylva_core::methods::hsm::{Hsm, HsmParams, HsmState, RawHsmClusterState, RawHsmStep};
+use sylva_core::pose::{Placement, Pose};
+
+/// Song's four stages on the GPU for one [`Hsm`] (a tree or a forest of copies).
+#[derive(Debug)]
+pub struct GpuHsm {
+    method: Arc<Hsm>,
+    tree: Option<Arc<Tree>>,
+    clusters_kernel: Arc<Kernel>,
+    goals_kernel: Arc<Kernel>,
+    integrate_kernel: Arc<Kernel>,
+    particles_kernel: Arc<Kernel>,
+    fused: bool,
+    pose_kernel: Arc<Kernel>,
+    pose: Option<GpuPose>,
+    wind: GpuWind,
+    info: wgpu::Buffer,
+    clusters: wgpu::Buffer,
+    slots: wgpu::Buffer,
+    owner: wgpu::Buffer,
+    member_offset: wgpu::Buffer,
+    member: wgpu::Buffer,
+    segment_cluster: wgpu::Buffer,
+    /// The substep parameters of the current submission, one after another.
+    steps: wgpu::Buffer,
+    steps_capacity: usize,
+    step: wgpu::Buffer,
+    displacement: wgpu::Buffer,
+    velocity: wgpu::Buffer,
+    state: wgpu::Buffer,
+    goal: wgpu::Buffer,
+    n_clusters: usize,
+    n_particles: usize,
+    /// Simulated time, s.
+    pub time: f32,
+}
+
+/// Most substeps recorded into one submission by [`GpuHsm::advance_steps`]; longer runs are split.
+pub const MAX_SUBSTEPS_PER_SUBMISSION: usize = 4096;
+
+impl GpuHsm {
+    /// The pose seam's buffers on the GPU, when built with the tree.
+    pub fn gpu_pose(&self) -> Option<&GpuPose> {
+        self.pose.as_ref()
+    }
+
+    /// Uploads the layout and the wind; the state starts at `method.rest_state()`. With a
+    /// `tree`, each step also writes the pose (the layout's segment clusters must be the
+    /// tree's); without one (a forest for benchmarks) only the particles are simulated.
+    pub fn new(ctx: &GpuContext, tree: Option<Arc<Tree>>, method: Arc<Hsm>, wind: &GpuWind) -> Result<Self, GpuError> {
+        let l = &method.layout;
+        let rest_state = method.state_at_rest();
+        let pose = match &tree {
+            Some(t) => Some(GpuPose::new(ctx, t)?),
+            None => None,
+        };
+        let step = method.step_params(0.0, 0.0);
+        let this = Self {
+            clusters_kernel: Kernel::get(ctx, "hsm_clusters"),
+            goals_kernel: Kernel::get(ctx, "hsm_goals"),
+            integrate_kernel: Kernel::get(ctx, "hsm_integrate"),
+            particles_kernel: Kernel::get(ctx, "hsm_particles"),
+            fused: method.params.fused,
+            pose_kernel: Kernel::get(ctx, "hsm_pose"),
+            pose,
+            wind: wind.clone(),
+            info: upload(ctx, "hsm cluster info", &l.info)?,
+            clusters: upload(ctx, "hsm clusters", &l.clusters)?,
+            slots: upload(ctx, "hsm slots", &l.slots)?,
+            owner: upload(ctx, "hsm owners", &l.owner)?,
+            member_offset: upload(ctx, "hsm member offsets", &l.member_offset)?,
+            member: upload(ctx, "hsm members", &l.member)?,
+            segment_cluster: upload(ctx, "hsm segment clusters", &l.segment_cluster)?,
+            steps: upload(ctx, "hsm substeps", &vec![step; method.params.substeps as usize])?,
+            steps_capacity: method.params.substeps as usize,
+            step: upload(ctx, "hsm step", &[step])?,
+            displacement: upload(ctx, "hsm displacements", &rest_state.displacement)?,
+            velocity: upload(ctx, "hsm velocities", &rest_state.velocity)?,
+            state: upload(ctx, "hsm cluster state", &rest_state.clusters)?,
+            goal: output::<[f32; 4]>(ctx, "hsm goals", l.rest.len())?,
+            n_clusters: l.info.len(),
+            n_particles: l.rest.len(),
+            time: 0.0,
+            method: method.clone(),
+            tree,
+        };
+        ctx.queue.write_buffer(&this.goal, 0, bytemuck::cast_slice(&rest_state.goal));
+        // The rest pose, until the first step writes one.
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        this.record_pose(ctx, &mut e);
+        ctx.queue.submit([e.finish()]);
+        Ok(this)
+    }
+
+    /// Replaces the GPU state by `state` (for example a settled CPU state).
+    pub fn write_state(&mut self, ctx: &GpuContext, state: &HsmState) {
+        ctx.queue.write_buffer(&self.displacement, 0, bytemuck::cast_slice(&state.displacement));
+        ctx.queue.write_buffer(&self.velocity, 0, bytemuck::cast_slice(&state.velocity));
+        ctx.queue.write_buffer(&self.state, 0, bytemuck::cast_slice(&state.clusters));
+        ctx.queue.write_buffer(&self.goal, 0, bytemuck::cast_slice(&state.goal));
+        self.time = state.time;
+    }
+
+    /// The method's layout and parameters.
+    pub fn method(&self) -> &Arc<Hsm> {
+        &self.method
+    }
+
+    /// Advances by one step of `dt` seconds in the method's substeps, all in one submission
+    /// (not waited for).
+    pub fn step(&mut self, ctx: &GpuContext, dt: f32) {
+        self.advance_steps(ctx, dt, 1);
+    }
+
+    /// Advances by `steps` steps of `dt` seconds; every substep of up to
+    /// [`MAX_SUBSTEPS_PER_SUBMISSION`] goes into one submission, the pose is written once at
+    /// the end (not waited for).
+    pub fn advance_steps(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
+        let method = self.method.clone();
+        let n = method.params.substeps.max(1) as usize;
+        let h = dt / n as f32;
+        let total = steps * n;
+        let mut done = 0;
+        while done < total {
+            let batch = (total - done).min(MAX_SUBSTEPS_PER_SUBMISSION);
+            // Times accumulate substep by substep as on the CPU (`state.time + h`).
+            let params: Vec<RawHsmStep> = (0..batch)
+                .map(|_| {
+                    self.time += h;
+                    method.step_params(self.time, h)
+                })
+                .collect();
+            if batch > self.steps_capacity {
+                self.steps = output::<RawHsmStep>(ctx, "hsm substeps", batch).expect("substep parameters fit");
+                self.steps_capacity = batch;
+            }
+            ctx.queue.write_buffer(&self.steps, 0, bytemuck::cast_slice(&params));
+            let mut e = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hsm") });
+            for k in 0..batch {
+                self.record_substep(ctx, &mut e, k);
+            }
+            done += batch;
+            if done == total {
+                self.record_pose(ctx, &mut e);
+            }
+            ctx.queue.submit([e.finish()]);
+        }
+    }
+
+    fn record_substep(&self, ctx: &GpuContext, e: &mut wgpu::CommandEncoder, k: usize) {
+        let size = std::mem::size_of::<RawHsmStep>() as u64;
+        e.copy_buffer_to_buffer(&self.steps, k as u64 * size, &self.step, 0, size);
+        let lanes = sylva_core::methods::hsm::kernels::LANES as u32;
+        self.clusters_kernel.record(
+            ctx,
+            e,
+            &[
+                &self.wind.fields,
+                &self.wind.waves,
+                &self.info,
+                &self.clusters,
+                &self.slots,
+                &self.displacement,
+                &self.step,
+                &self.state,
+            ],
+            self.n_clusters as u32 * lanes,
+        );
+        if self.fused {
+            self.particles_kernel.record(
+                ctx,
+                e,
+                &[
+                    &self.member_offset,
+                    &self.member,
+                    &self.state,
+                    &self.owner,
+                    &self.step,
+                    &self.displacement,
+                    &self.velocity,
+                ],
+                self.n_particles as u32,
+            );
+            return;
+        }
+        self.goals_kernel.record(
+            ctx,
+            e,
+            &[&self.member_offset, &self.member, &self.state, &self.goal],
+            self.n_particles as u32,
+        );
+        self.integrate_kernel.record(
+            ctx,
+            e,
+            &[&self.owner, &self.state, &self.goal, &self.step, &self.displacement, &self.velocity],
+            self.n_particles as u32,
+        );
+    }
+
+    fn record_pose(&self, ctx: &GpuContext, e: &mut wgpu::CommandEncoder) {
+        if let Some(pose) = &self.pose {
+            self.pose_kernel.record(
+                ctx,
+                e,
+                &[&self.segment_cluster, &self.state, pose.acc_buffer()],
+                pose.segment_count() as u32,
+            );
+            pose.record_positions(ctx, e);
+        }
+    }
+
+    /// Reads the particle and cluster state back (waits for the GPU).
+    pub fn read_state(&self, ctx: &GpuContext) -> Result<HsmState, GpuError> {
+        use crate::kernel::read_back;
+        Ok(HsmState {
+            displacement: read_back(ctx, &self.displacement, self.n_particles)?,
+            velocity: read_back(ctx, &self.velocity, self.n_particles)?,
+            clusters: read_back::<RawHsmClusterState>(ctx, &self.state, self.n_clusters)?,
+            goal: read_back(ctx, &self.goal, self.n_particles)?,
+            time: self.time,
+        })
+    }
+
+    /// Reads the pose written by the last step back (waits for the GPU); `None` without a
+    /// tree.
+    pub fn read_pose(&self, ctx: &GpuContext) -> Result<Option<Pose>, GpuError> {
+        self.pose.as_ref().map(|p| p.read(ctx)).transpose()
+    }
+}
+
+/// The registry's GPU constructor: hierarchical shape matching on `tree` (its copies share
+/// it).
+pub fn animator(
+    ctx: &GpuContext,
+    tree: Arc<Tree>,
+    options: &MethodOptions,
+    wind: &GpuWind,
+    _instances: &[Placement],
+) -> Result<Box<dyn GpuAnimator>, BuildError> {
+    let params = options.parse::<HsmParams>("hsm")?;
+    let method = Hsm::new(&tree, params).map_err(sylva_core::methods::MethodError::from)?;
+    Ok(Box::new(GpuHsm::new(ctx, Some(tree), Arc::new(method), wind)?))
+}
+
+impl GpuAnimator for GpuHsm {
+    fn name(&self) -> &'static str {
+        "hsm"
+    }
+    fn tree(&self) -> &Arc<Tree> {
+        self.tree.as_ref().expect("the registry builds HSM with its tree")
+    }
+    fn set_wind(&mut self, wind: &GpuWind) {
+        self.wind = wind.clone();
+    }
+    fn reset(&mut self, ctx: &GpuContext) {
+        self.write_state(ctx, &self.method.state_at_rest());
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        self.record_pose(ctx, &mut e);
+        ctx.queue.submit([e.finish()]);
+    }
+    fn advance(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
+        self.advance_steps(ctx, dt, steps);
+    }
+    fn time(&self) -> f32 {
+        self.time
+    }
+    fn pose_buffers(&self) -> &GpuPose {
+        self.pose.as_ref().expect("the registry builds HSM with its tree")
+    }
+    fn cluster_centres(&self, ctx: &GpuContext) -> Result<Option<Vec<Vec3>>, GpuError> {
+        let state = self.read_state(ctx)?;
+        Ok(Some(state.clusters.iter().map(|c| Vec3::new(c.cm[0], c.cm[1], c.cm[2])).collect()))
+    }
+    fn particles(&self) -> Option<usize> {
+        Some(self.n_particles)
+    }
+}

@@ -1,0 +1,204 @@
+//! Skjermo's method on the GPU: the step (ping-pong state buffers), the seam rotations and
+//! forward kinematics in one submission per step; the curves stay on the device for the
+//! deformer.
+
+use super::{BuildError, GpuAnimator, GpuCurves};
+use crate::kernel::{Kernel, output, read_back, upload};
+use crate::pose::GpuPose;
+use crate::wind::GpuWind;
+use crate::{GpuContext, GpuError};
+use glam::Vec3;
+use std::sync::Arc;
+use sylva_core::Tree;
+use sylva_core::methods::MethodOptions;
+use sylva_core::methods::skjermo::{RawSkjermoState, RawSkjermoStep, Skjermo, SkjermoParams};
+use sylva_core::pose::{Placement, Pose};
+
+/// Skjermo's method on the GPU for one tree.
+#[derive(Debug)]
+pub struct GpuSkjermo {
+    tree: Arc<Tree>,
+    step_kernel: Arc<Kernel>,
+    rotations: Arc<Kernel>,
+    pose: GpuPose,
+    wind: GpuWind,
+    stems: wgpu::Buffer,
+    params: wgpu::Buffer,
+    step: wgpu::Buffer,
+    state: [wgpu::Buffer; 2],
+    current: usize,
+    /// The rest state as the device rounds it.
+    rest: Vec<RawSkjermoState>,
+    /// Each stem's rest control points.
+    rest_curves: Vec<[Vec3; 4]>,
+    method_step: RawSkjermoStep,
+    /// Simulated time, s.
+    pub time: f32,
+}
+
+impl GpuSkjermo {
+    /// Uploads the tree and Skjermo's constants and binds the scene's wind; the state starts
+    /// at rest.
+    pub fn new(ctx: &GpuContext, tree: Arc<Tree>, method: &Skjermo, wind: &GpuWind) -> Result<Self, GpuError> {
+        // The rest orientations as this device rounds them (a GPU that fuses multiply-adds
+        // rounds the attachment frames differently from the CPU): with the CPU's, a step in
+        // still air would move the stems by rounding errors instead of keeping the rest.
+        let stems_buffer = upload(ctx, "skjermo stems", &method.stems)?;
+        let orient = Self::rest_orientations(ctx, &stems_buffer, method)?;
+        let mut stems = method.stems.clone();
+        for st in &mut stems {
+            if st.parent != sylva_core::model::NONE {
+                st.parent_orient = orient[st.parent as usize];
+            }
+        }
+        ctx.queue.write_buffer(&stems_buffer, 0, bytemuck::cast_slice(&stems));
+        let rest: Vec<RawSkjermoState> =
+            orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect();
+        Ok(Self {
+            step_kernel: Kernel::get(ctx, "skjermo_step"),
+            rotations: Kernel::get(ctx, "skjermo_rotations"),
+            pose: GpuPose::new(ctx, &tree)?,
+            wind: wind.clone(),
+            stems: stems_buffer,
+            params: upload(ctx, "segment params", &method.segment_param)?,
+            step: upload(ctx, "skjermo step", &[method.step_params(0.0)])?,
+            state: [upload(ctx, "skjermo state a", &rest)?, upload(ctx, "skjermo state b", &rest)?],
+            current: 0,
+            rest,
+            rest_curves: method.stems.iter().map(|s| s.rest.map(|p| Vec3::from_slice(&p[..3]))).collect(),
+            method_step: method.step_params(0.0),
+            time: 0.0,
+            tree,
+        })
+    }
+
+    /// Skjermo's per-stem constants on the GPU (`RawSkjermoStem`).
+    pub fn stems_buffer(&self) -> &wgpu::Buffer {
+        &self.stems
+    }
+
+    /// The current per-stem state (`RawSkjermoState`: control-point displacements).
+    pub fn state_buffer(&self) -> &wgpu::Buffer {
+        &self.state[self.current]
+    }
+
+    /// The rest orientation vectors computed on the device: `skjermo_rest_orient` once per
+    /// stem depth, ping-pong, over the uploaded `stems` (whose parent orientations it does
+    /// not read; waits for the GPU).
+    fn rest_orientations(ctx: &GpuContext, stems: &wgpu::Buffer, method: &Skjermo) -> Result<Vec<[f32; 4]>, GpuError> {
+        let kernel = Kernel::get(ctx, "skjermo_rest_orient");
+        let orient = [
+            upload(ctx, "skjermo rest orientations a", &method.rest_orient)?,
+            output::<[f32; 4]>(ctx, "skjermo rest orientations b", method.stems.len())?,
+        ];
+        let levels = sylva_core::methods::skjermo::kernels::stem_depth(&method.stems) + 1;
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        for level in 0..levels {
+            let (from, to) = (&orient[level % 2], &orient[1 - level % 2]);
+            kernel.record(ctx, &mut e, &[stems, from, to], method.stems.len() as u32);
+        }
+        ctx.queue.submit([e.finish()]);
+        read_back(ctx, &orient[levels % 2], method.stems.len())
+    }
+
+    /// Advances by one step of `dt` seconds (submitted, not waited for).
+    pub fn step(&mut self, ctx: &GpuContext, dt: f32) {
+        self.step_with(ctx, dt, true);
+    }
+
+    /// Advances the curves only (no pose): Skjermo's branch update as the paper measures it.
+    pub fn step_only(&mut self, ctx: &GpuContext, dt: f32) {
+        self.step_with(ctx, dt, false);
+    }
+
+    fn step_with(&mut self, ctx: &GpuContext, dt: f32, with_pose: bool) {
+        self.time += dt;
+        let step = RawSkjermoStep { time: self.time, ..self.method_step };
+        ctx.queue.write_buffer(&self.step, 0, bytemuck::bytes_of(&step));
+        let (prev, next) = (&self.state[self.current], &self.state[1 - self.current]);
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        self.step_kernel.record(
+            ctx,
+            &mut e,
+            &[&self.wind.fields, &self.wind.waves, &self.stems, prev, &self.step, next],
+            self.rest.len() as u32,
+        );
+        if with_pose {
+            let pose = &self.pose;
+            self.rotations.record(
+                ctx,
+                &mut e,
+                &[&self.params, &self.stems, next, pose.parents_buffer(), pose.delta_buffer()],
+                pose.segment_count() as u32,
+            );
+            pose.record(ctx, &mut e);
+        }
+        ctx.queue.submit([e.finish()]);
+        self.current = 1 - self.current;
+    }
+
+    /// Reads the current pose back, with the animated Béziers (waits for the GPU).
+    pub fn read(&self, ctx: &GpuContext) -> Result<Pose, GpuError> {
+        let mut pose = self.pose.read(ctx)?;
+        let state: Vec<RawSkjermoState> = read_back(ctx, &self.state[self.current], self.rest.len())?;
+        pose.bezier = Some(
+            self.rest_curves
+                .iter()
+                .zip(&state)
+                .map(|(r, s)| [0, 1, 2, 3].map(|j| r[j] + Vec3::from_slice(&s.delta[j][..3])))
+                .collect(),
+        );
+        Ok(pose)
+    }
+}
+
+/// The registry's GPU constructor: Skjermo's method on `tree` (its copies share it).
+pub fn animator(
+    ctx: &GpuContext,
+    tree: Arc<Tree>,
+    options: &MethodOptions,
+    wind: &GpuWind,
+    _instances: &[Placement],
+) -> Result<Box<dyn GpuAnimator>, BuildError> {
+    let params = options.parse::<SkjermoParams>("skjermo")?;
+    params.check()?;
+    let method = Skjermo::new(&tree, params);
+    Ok(Box::new(GpuSkjermo::new(ctx, tree, &method, wind)?))
+}
+
+impl GpuAnimator for GpuSkjermo {
+    fn name(&self) -> &'static str {
+        "skjermo"
+    }
+    fn tree(&self) -> &Arc<Tree> {
+        &self.tree
+    }
+    fn set_wind(&mut self, wind: &GpuWind) {
+        self.wind = wind.clone();
+    }
+    fn reset(&mut self, ctx: &GpuContext) {
+        for s in &self.state {
+            ctx.queue.write_buffer(s, 0, bytemuck::cast_slice(&self.rest));
+        }
+        self.current = 0;
+        self.pose.write_rest(ctx, &self.tree);
+        self.time = 0.0;
+    }
+    fn advance(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
+        for _ in 0..steps {
+            self.step(ctx, dt);
+        }
+    }
+    fn time(&self) -> f32 {
+        self.time
+    }
+    fn pose_buffers(&self) -> &GpuPose {
+        &self.pose
+    }
+    fn read_pose(&self, ctx: &GpuContext) -> Result<Pose, GpuError> {
+        self.read(ctx)
+    }
+    fn curves(&self) -> Option<GpuCurves<'_>> {
+        Some(GpuCurves { stems: &self.stems, state: &self.state[self.current] })
+    }
+}

@@ -1,0 +1,135 @@
+//! The kernel registry: every compute kernel by name, the WGSL sources composed (in order)
+//! into its module, and its CPU twin in `sylva-core`. Pipelines are built from it
+//! ([`crate::kernel::Kernel::get`]) and the naga tests validate every entry, so a kernel
+//! is added in one place.
+//!
+//! Shared pieces (`wgsl/`) are composed in front of a kernel, never copied. A kernel's WGSL
+//! sits beside the Rust that drives it (`methods/hsm/hsm_clusters.wgsl` beside
+//! `methods/hsm/mod.rs`). The CPU twin has the kernel's name, binding order and loop shape,
+//! and its path is checked by the compiler.
+
+/// Quaternion helpers (`quat_rotate`, `quat_mul`), unit quaternions as `vec4<f32>(x, y, z, w)`.
+pub const QUAT: &str = include_str!("wgsl/quat.wgsl");
+/// The tree model's structs (`Segment`, `Stem`, `Leaf`), twins of `sylva_core::model::Raw*`.
+pub const TREE: &str = include_str!("wgsl/tree.wgsl");
+/// Integer hash and value noise (twin of `sylva_core::wind::noise`).
+pub const NOISE: &str = include_str!("wgsl/noise.wgsl");
+/// Wind fields: `Field`, `Wave`, `wind_at(p, t)`; binds the scene at bindings 0 and 1.
+pub const WIND: &str = include_str!("wgsl/wind.wgsl");
+
+/// Kernel: wind velocity at many (x, t) samples.
+pub const WIND_SAMPLE: &str = include_str!("wind/wind_sample.wgsl");
+/// Kernel: segment end points from start, orientation and length.
+pub const SEGMENT_ENDS: &str = include_str!("pose/segment_ends.wgsl");
+/// Kernel: accumulated rotations by ancestor walk (the pose seam).
+pub const POSE_ACCUMULATE: &str = include_str!("pose/pose_accumulate.wgsl");
+/// Kernel: posed joint positions by ancestor walk (the pose seam).
+pub const POSE_POSITIONS: &str = include_str!("pose/pose_positions.wgsl");
+/// Kernel: one depth of forward kinematics, root first (the level-by-level alternative).
+pub const POSE_LEVEL: &str = include_str!("pose/pose_level.wgsl");
+/// Kernel: Zioma's per-segment rotations.
+pub const ZIOMA_ROTATIONS: &str = include_str!("methods/zioma/zioma_rotations.wgsl");
+/// Kernel: trunk noise bands at many (t, tree) samples.
+pub const TRUNK_NOISE: &str = include_str!("methods/zioma/trunk_noise.wgsl");
+/// Akagi's shared structs (`AkagiSegment`, `AkagiStep`).
+pub const AKAGI: &str = include_str!("methods/akagi/akagi.wgsl");
+/// Kernel: Akagi's own wind force per segment.
+pub const AKAGI_FORCES: &str = include_str!("methods/akagi/akagi_forces.wgsl");
+/// Kernel: one depth of Akagi's force propagation.
+pub const AKAGI_SUBTREE: &str = include_str!("methods/akagi/akagi_subtree.wgsl");
+/// Kernel: Akagi's damped angular springs.
+pub const AKAGI_INTEGRATE: &str = include_str!("methods/akagi/akagi_integrate.wgsl");
+/// Skjermo's shared structs and Bézier helpers.
+pub const SKJERMO: &str = include_str!("methods/skjermo/skjermo.wgsl");
+/// Kernel: Skjermo's re-attachment and bending.
+pub const SKJERMO_STEP: &str = include_str!("methods/skjermo/skjermo_step.wgsl");
+/// Kernel: seam rotations from Skjermo's curves.
+pub const SKJERMO_ROTATIONS: &str = include_str!("methods/skjermo/skjermo_rotations.wgsl");
+/// Kernel: one level of Skjermo's rest orientation vectors, as the device rounds them.
+pub const SKJERMO_REST_ORIENT: &str = include_str!("methods/skjermo/skjermo_rest_orient.wgsl");
+/// Song's linearised tree (`HsmCluster`, …) and the rotation extraction.
+pub const HSM: &str = include_str!("methods/hsm/hsm.wgsl");
+/// Kernel: HSM stage 1, per cluster (workgroup reduction).
+pub const HSM_CLUSTERS: &str = include_str!("methods/hsm/hsm_clusters.wgsl");
+/// Stage 3's per-particle gather (`hsm_particle_goal`), shared by two kernels.
+pub const HSM_GATHER: &str = include_str!("methods/hsm/hsm_gather.wgsl");
+/// Kernel: HSM stage 3, per-particle goals.
+pub const HSM_GOALS: &str = include_str!("methods/hsm/hsm_goals.wgsl");
+/// Stage 4's particle update (`hsm_advance`), shared by two kernels.
+pub const HSM_ADVANCE: &str = include_str!("methods/hsm/hsm_advance.wgsl");
+/// Kernel: HSM stage 4, per-particle integration.
+pub const HSM_INTEGRATE: &str = include_str!("methods/hsm/hsm_integrate.wgsl");
+/// Kernel: HSM stages 3 and 4 fused, per particle.
+pub const HSM_PARTICLES: &str = include_str!("methods/hsm/hsm_particles.wgsl");
+/// Kernel: seam rotations from HSM's clusters.
+pub const HSM_POSE: &str = include_str!("methods/hsm/hsm_pose.wgsl");
+/// Per-frame meshing structs (`Ring`, `MeshInfo`, `Detail`, `Vertex`) and the bark relief.
+pub const MESH: &str = include_str!("mesh/mesh.wgsl");
+/// Kernel: bark vertices of every tube.
+pub const MESH_TUBES: &str = include_str!("mesh/mesh_tubes.wgsl");
+/// Kernel: midpoint vertices of subdivided bark bands (§2.3).
+pub const MESH_DETAIL: &str = include_str!("mesh/mesh_detail.wgsl");
+/// Kernel: leaf-polygon vertices.
+pub const MESH_LEAVES: &str = include_str!("mesh/mesh_leaves.wgsl");
+/// Kernel: two-bone skinning of a rest mesh, instance-major.
+pub const SKIN_VERTICES: &str = include_str!("mesh/skin_vertices.wgsl");
+/// Kernel: Skjermo's deformer (grid → branch → bent along the Bézier).
+pub const SKJERMO_DEFORM: &str = include_str!("mesh/skjermo_deform.wgsl");
+
+/// One compute kernel of the registry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KernelDef {
+    /// The kernel's name (its WGSL file's stem, and its CPU twin's function name).
+    pub name: &'static str,
+    /// The WGSL sources composed, in order, into its module; its entry point is `main`.
+    pub sources: &'static [&'static str],
+    /// The path of its CPU twin in `sylva-core` (the compiler checks that it exists).
+    pub cpu_twin: &'static str,
+}
+
+macro_rules! kernels {
+    ($($name:ident: [$($src:ident),* $(,)?] => $twin:path;)*) => {
+        /// Every kernel: name → composed WGSL sources → CPU twin.
+        pub const KERNELS: &[KernelDef] = &[
+            $(KernelDef { name: stringify!($name), sources: &[$($src),*], cpu_twin: stringify!($twin) },)*
+        ];
+        // Each twin must exist: naming it here fails to compile when it moves or goes.
+        const _: () = { $(let _ = $twin;)* };
+    };
+}
+
+kernels! {
+    wind_sample: [NOISE, WIND, WIND_SAMPLE] => sylva_core::wind::sample::wind_sample;
+    segment_ends: [QUAT, TREE, SEGMENT_ENDS] => sylva_core::pose::segment_ends::segment_ends;
+    pose_accumulate: [QUAT, TREE, POSE_ACCUMULATE] => sylva_core::pose::fk::pose_accumulate;
+    pose_positions: [QUAT, TREE, POSE_POSITIONS] => sylva_core::pose::fk::pose_positions;
+    pose_level: [QUAT, TREE, POSE_LEVEL] => sylva_core::pose::fk::pose_level;
+    trunk_noise: [NOISE, TRUNK_NOISE] => sylva_core::methods::zioma::trunk::trunk_noise;
+    zioma_rotations: [QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS] => sylva_core::methods::zioma::rotations::zioma_rotations;
+    akagi_forces: [QUAT, TREE, NOISE, WIND, AKAGI, AKAGI_FORCES] => sylva_core::methods::akagi::kernels::akagi_forces;
+    akagi_subtree: [AKAGI_SUBTREE] => sylva_core::methods::akagi::kernels::akagi_subtree;
+    akagi_integrate: [QUAT, TREE, AKAGI, AKAGI_INTEGRATE] => sylva_core::methods::akagi::kernels::akagi_integrate;
+    skjermo_step: [QUAT, TREE, NOISE, WIND, SKJERMO, SKJERMO_STEP] => sylva_core::methods::skjermo::kernels::skjermo_step;
+    skjermo_rotations: [QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS] => sylva_core::methods::skjermo::kernels::skjermo_rotations;
+    skjermo_rest_orient: [QUAT, TREE, SKJERMO, SKJERMO_REST_ORIENT] => sylva_core::methods::skjermo::kernels::skjermo_rest_orient;
+    hsm_clusters: [QUAT, NOISE, WIND, HSM, HSM_CLUSTERS] => sylva_core::methods::hsm::kernels::hsm_clusters;
+    hsm_goals: [QUAT, HSM, HSM_GATHER, HSM_GOALS] => sylva_core::methods::hsm::kernels::hsm_goals;
+    hsm_integrate: [QUAT, HSM, HSM_ADVANCE, HSM_INTEGRATE] => sylva_core::methods::hsm::kernels::hsm_integrate;
+    hsm_particles: [QUAT, HSM, HSM_GATHER, HSM_ADVANCE, HSM_PARTICLES] => sylva_core::methods::hsm::kernels::hsm_particles;
+    hsm_pose: [QUAT, TREE, HSM, HSM_POSE] => sylva_core::methods::hsm::kernels::hsm_pose;
+    mesh_tubes: [QUAT, TREE, NOISE, MESH, MESH_TUBES] => sylva_core::mesh::mesh_tubes;
+    mesh_detail: [NOISE, MESH, MESH_DETAIL] => sylva_core::mesh::mesh_detail;
+    mesh_leaves: [QUAT, TREE, NOISE, MESH, MESH_LEAVES] => sylva_core::mesh::mesh_leaves;
+    skin_vertices: [QUAT, NOISE, MESH, SKIN_VERTICES] => sylva_core::mesh::skin_vertices;
+    skjermo_deform: [QUAT, TREE, NOISE, MESH, SKJERMO, SKJERMO_DEFORM] => sylva_core::mesh::skjermo_deform;
+}
+
+/// The registered kernel `name`.
+pub fn kernel(name: &str) -> Option<&'static KernelDef> {
+    KERNELS.iter().find(|k| k.name == name)
+}
+
+/// Concatenates WGSL sources into one module.
+pub fn compose(parts: &[&str]) -> String {
+    parts.join("\n")
+}
