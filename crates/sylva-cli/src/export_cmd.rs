@@ -1,15 +1,15 @@
 //! `sylva export`: a tree as glTF 2.0 (`.glb` or `.gltf`) with a skin and wind baked from
 //! any method, hierarchy attributes for engine-side wind, and levels of detail.
 
-use crate::simulate_cmd::{Method, TreeWindArgs};
+use crate::simulate_cmd::TreeWindArgs;
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Instant;
-use sylva_core::Tree;
 use sylva_core::export::{BakeParams, DEFAULT_LODS, GltfOptions, JointMode, Lod, bake, write_gltf};
-use sylva_core::scene::MethodName;
+use sylva_core::methods::Animator;
 use sylva_core::wind::WindScene;
+use sylva_runtime::MethodRegistry;
 
 /// Joints of the skin.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -80,18 +80,6 @@ fn parse_lod(s: &str) -> Result<Lod, String> {
     })
 }
 
-impl Method {
-    /// The core's name for the method.
-    pub fn name(self) -> MethodName {
-        match self {
-            Method::Zioma => MethodName::Zioma,
-            Method::Akagi => MethodName::Akagi,
-            Method::Skjermo => MethodName::Skjermo,
-            Method::Hsm => MethodName::Hsm,
-        }
-    }
-}
-
 /// Runs the command; returns the file written.
 pub fn run(a: &ExportArgs) -> Result<PathBuf> {
     let out = a.out.clone().unwrap_or_else(|| {
@@ -101,8 +89,6 @@ pub fn run(a: &ExportArgs) -> Result<PathBuf> {
         PathBuf::from("out").join(format!("{stem}.glb"))
     });
     let params = BakeParams {
-        method: a.tree.method.name(),
-        seed: a.tree.seed,
         seconds: a.seconds,
         fps: a.fps,
         looped: a.looped,
@@ -119,22 +105,26 @@ pub fn run(a: &ExportArgs) -> Result<PathBuf> {
         lods: if a.lods.is_empty() { DEFAULT_LODS.to_vec() } else { a.lods.clone() },
     };
     let (tree, wind) = a.tree.resolve()?;
+    let tree = std::sync::Arc::new(tree);
+    let mut anim = MethodRegistry::builtin().cpu(&a.tree.method, tree.clone(), &a.tree.options())?;
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    export(&tree, &wind, &params, &opts, a.static_only, &out)?;
+    export(anim.as_mut(), &wind, &params, &opts, a.static_only, &out)?;
     Ok(out)
 }
 
-/// Bakes (unless static) and writes, printing what was written and how long it took.
+/// Bakes `anim` (unless static) and writes, printing what was written and how long it took.
 pub fn export(
-    tree: &Tree,
+    anim: &mut dyn Animator,
     wind: &WindScene,
     params: &BakeParams,
     opts: &GltfOptions,
     static_only: bool,
     out: &std::path::Path,
 ) -> Result<()> {
+    let tree = anim.tree().clone();
+    let tree = &*tree;
     let t0 = Instant::now();
     let clip = if static_only {
         None
@@ -144,8 +134,8 @@ pub fn export(
             ProgressStyle::with_template("baking {msg} {bar:40} {pos}/{len} frames, {eta} left")
                 .expect("static template"),
         );
-        bar.set_message(params.method.as_str());
-        let clip = bake(tree, wind, params, &mut |done, total| {
+        bar.set_message(anim.name());
+        let clip = bake(anim, wind, params, &mut |done, total| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
         })

@@ -1,17 +1,12 @@
-//! `sylva`: grow trees and move them in the wind.
+//! `sylva`: grow trees and move them in the wind. A thin shell over the libraries: the
+//! runtime (`sylva-runtime`) runs scenes, the bench harness (`sylva-bench`) the papers'
+//! tables, the viewer (`sylva-viewer`) the window.
 //!
 //! With no arguments, runs the main job: `sylva render` on the built-in default scene.
 
-mod bench_akagi;
-mod bench_cmd;
-mod bench_skjermo;
-mod bench_zioma;
 mod export_cmd;
 mod render_cmd;
-mod scene_runtime;
 mod simulate_cmd;
-#[cfg(feature = "viewer")]
-mod view_app;
 mod view_cmd;
 mod wind_cmd;
 
@@ -45,7 +40,7 @@ enum Command {
     /// with ffmpeg installed, an MP4.
     Render(render_cmd::RenderArgs),
     /// Reproduce a paper's result table on the CPU and the GPU, with plots.
-    Bench(bench_cmd::BenchArgs),
+    Bench(sylva_bench::BenchArgs),
     /// Export a tree as glTF 2.0 (.glb/.gltf): mesh, materials, a skin and wind baked from
     /// any method (optionally looping), hierarchy attributes for engine wind shaders, LODs.
     Export(export_cmd::ExportArgs),
@@ -96,7 +91,7 @@ fn main() -> Result<()> {
         Some(Command::Export(args)) => export_cmd::run(&args).map(|_| ()),
         Some(Command::View(args)) => view_cmd::run(&args),
         Some(Command::Bench(args)) => {
-            for p in bench_cmd::run(&args)? {
+            for p in sylva_bench::run(&args)? {
                 println!("wrote {}", p.display());
             }
             Ok(())

@@ -1,21 +1,21 @@
-//! `sylva render`: the main job. Grows every tree of a scene, animates each with its method
-//! (CPU or GPU), meshes every frame on the GPU, renders it (sun, shadows, sky, ground,
-//! instancing) and writes a GIF, PNG frames and, when `ffmpeg` is installed, an MP4 — each
-//! file complete or not at all.
+//! `sylva render`: the main job. The runtime's world grows every tree of a scene, animates
+//! each with its method (CPU or GPU) and meshes every frame on the GPU; this renders it
+//! (sun, shadows, sky, ground, instancing) and writes a GIF, PNG frames and, when `ffmpeg` is
+//! installed, an MP4 — each file complete or not at all, whatever signal arrives.
 
-use crate::scene_runtime::Entry;
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
+use sylva_core::io::PendingFile;
 use sylva_core::scene::{BackendChoice, Scene};
-use sylva_core::wind::WindScene;
 use sylva_gpu::GpuContext;
-use sylva_gpu::render::{Camera, DrawItem, Lighting, RenderSettings, Renderer};
+use sylva_gpu::render::{Camera, Lighting, RenderSettings, Renderer};
+use sylva_runtime::{MethodRegistry, World, WorldTree};
 
 /// Arguments of `sylva render`.
 #[derive(clap::Args, Debug, Default)]
@@ -57,37 +57,6 @@ pub enum BackendArg {
     Cpu,
     /// GPU kernels.
     Gpu,
-}
-
-/// A temporary file renamed into place on success and removed otherwise.
-struct Pending {
-    tmp: PathBuf,
-    path: PathBuf,
-    done: bool,
-}
-
-impl Pending {
-    fn new(path: &Path) -> Self {
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        // The extension is kept last: encoders pick the format from it.
-        let ext = path.extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
-        let tmp = path.with_file_name(format!(".{name}.tmp-{}.{ext}", std::process::id()));
-        Self { tmp, path: path.to_path_buf(), done: false }
-    }
-
-    fn commit(mut self) -> Result<()> {
-        std::fs::rename(&self.tmp, &self.path).with_context(|| format!("writing {}", self.path.display()))?;
-        self.done = true;
-        Ok(())
-    }
-}
-
-impl Drop for Pending {
-    fn drop(&mut self) {
-        if !self.done {
-            let _ = std::fs::remove_file(&self.tmp);
-        }
-    }
 }
 
 fn ffmpeg_available() -> bool {
@@ -174,25 +143,16 @@ pub fn run(a: &RenderArgs) -> Result<()> {
 
 fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
     let o = &scene.output;
-    let ctx = GpuContext::shared()?;
+    let ctx = GpuContext::shared_arc()?;
     println!("GPU: {}", ctx.summary);
-    let wind = WindScene::resolve(&scene.resolve_path(&scene.wind))
-        .with_context(|| format!("{}: field `wind`", scene.file))?;
-    let (fields, waves) = wind.pack();
-
     let steps = (o.sim_rate / o.fps).round().max(1.0) as usize;
     let dt = 1.0 / (o.fps * steps as f32);
     let setup = Instant::now();
-    let mut entries = Vec::new();
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    let mut triangles = 0usize;
-    for (i, st) in scene.trees.iter().enumerate() {
-        let e = Entry::build(ctx, scene, i, st, &wind, dt)?;
-        println!("{}", e.summary());
-        (lo, hi) = (lo.min(e.bounds.0), hi.max(e.bounds.1));
-        triangles += e.triangles;
-        entries.push(e);
+    let mut world = World::with(ctx.clone(), scene.clone(), Arc::new(MethodRegistry::builtin()), dt)?;
+    for t in world.trees() {
+        println!("{}", t.summary());
     }
+    let ctx = &*ctx;
     let renderer =
         Renderer::new(ctx, RenderSettings { width: o.width, height: o.height, msaa: o.msaa, ..Default::default() })?;
     let camera = Camera {
@@ -205,10 +165,11 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         sun_intensity: scene.sun.intensity,
         ..Default::default()
     };
-    let globals = renderer.globals(&camera, &light, (lo, hi));
+    let globals = renderer.globals(&camera, &light, world.bounds());
     let view_proj = camera.view_proj(o.width as f32 / o.height as f32);
     let labels: Vec<(String, f32, f32)> = if o.labels {
-        entries
+        world
+            .trees()
             .iter()
             .enumerate()
             .filter_map(|(k, e)| {
@@ -226,7 +187,7 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         Vec::new()
     };
     if o.labels {
-        let _ = plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, crate::wind_cmd::FONT);
+        sylva_bench::plot::register_font();
     }
 
     std::fs::create_dir_all(&o.dir).with_context(|| format!("creating {}", o.dir.display()))?;
@@ -236,10 +197,10 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
     }
     let frames = scene.frames();
     let gif_path = o.dir.join(format!("{}.gif", o.name));
-    let gif_pending = o.gif.then(|| Pending::new(&gif_path));
+    let gif_pending = o.gif.then(|| PendingFile::new(&gif_path)).transpose()?;
     let mut gif = match &gif_pending {
         Some(p) => {
-            let f = std::fs::File::create(&p.tmp).with_context(|| format!("creating {}", p.tmp.display()))?;
+            let f = p.create().with_context(|| format!("creating {}", p.tmp().display()))?;
             let mut enc = image::codecs::gif::GifEncoder::new_with_speed(std::io::BufWriter::new(f), 10);
             enc.set_repeat(image::codecs::gif::Repeat::Infinite)?;
             Some(enc)
@@ -247,7 +208,7 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         None => None,
     };
     let mp4_path = o.dir.join(format!("{}.mp4", o.name));
-    let mp4_pending = (o.mp4 && ffmpeg_available()).then(|| Pending::new(&mp4_path));
+    let mp4_pending = (o.mp4 && ffmpeg_available()).then(|| PendingFile::new(&mp4_path)).transpose()?;
     let mut ffmpeg = match &mp4_pending {
         Some(p) => Some(
             std::process::Command::new("ffmpeg")
@@ -255,7 +216,7 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
                 .arg(format!("{}x{}", o.width, o.height))
                 .args(["-r", &o.fps.to_string(), "-i", "-", "-c:v", "libx264", "-pix_fmt", "yuv420p"])
                 .args(["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-movflags", "+faststart", "-f", "mp4"])
-                .arg(&p.tmp)
+                .arg(p.tmp())
                 .stdin(std::process::Stdio::piped())
                 .spawn()
                 .context("starting ffmpeg")?,
@@ -266,17 +227,11 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
     // Pre-roll: stateful methods start at rest; let the wind move them first.
     // Phase groups pre-roll further, each by its own lead.
     let preroll_steps = (o.preroll * o.fps * steps as f32).round() as usize;
-    let leads = entries.iter().any(Entry::has_leads);
-    let prerolled = preroll_steps > 0 || leads;
-    let mut t = 0.0f32;
+    let prerolled = preroll_steps > 0 || world.trees().iter().any(WorldTree::has_leads);
     if prerolled {
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        t = preroll_steps as f32 * dt;
-        for e in &mut entries {
-            e.advance(ctx, (&fields, &waves), t, dt, preroll_steps, true, &mut encoder)?;
-        }
-        ctx.queue.submit([encoder.finish()]);
+        world.preroll(preroll_steps);
     }
+    let triangles = world.triangles();
     println!("set up in {:.2} s; {} triangles per frame", setup.elapsed().as_secs_f64(), triangles);
 
     let bar = ProgressBar::new(frames as u64);
@@ -291,24 +246,20 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
             bail!("interrupted after {f} of {frames} frames; no partial animation was written");
         }
         let t0 = Instant::now();
+        world.step(if f == 0 && prerolled { 0 } else { steps })?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let advance = if f == 0 && prerolled { 0 } else { steps };
-        t += advance as f32 * dt;
-        for e in &mut entries {
-            e.advance(ctx, (&fields, &waves), t, dt, advance, false, &mut encoder)?;
-        }
+        world.record(&mut encoder);
         let t1 = Instant::now();
-        let items: Vec<DrawItem<'_>> = entries.iter().flat_map(Entry::draw_items).collect();
-        renderer.record(ctx, &mut encoder, &globals, &items);
+        renderer.record(ctx, &mut encoder, &globals, &world.draw_items());
         let mut rgba = renderer.read_image(ctx, encoder)?;
         let t2 = Instant::now();
         draw_labels(&mut rgba, o.width, o.height, &labels)?;
         let img = image::RgbaImage::from_raw(o.width, o.height, rgba).context("image size")?;
         if o.png {
             let path = frames_dir.join(format!("{}_{f:04}.png", o.name));
-            let p = Pending::new(&path);
-            img.save(&p.tmp).with_context(|| format!("writing {}", p.tmp.display()))?;
-            p.commit()?;
+            let p = PendingFile::new(&path)?;
+            img.save(p.tmp()).with_context(|| format!("writing {}", p.tmp().display()))?;
+            p.commit().with_context(|| format!("writing {}", path.display()))?;
         }
         if let Some(enc) = &mut gif {
             let delay = image::Delay::from_numer_denom_ms(1000, o.fps.round().max(1.0) as u32);
@@ -327,7 +278,7 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         drop(enc);
     }
     if let Some(p) = gif_pending {
-        p.commit()?;
+        p.commit().with_context(|| format!("writing {}", gif_path.display()))?;
         println!("wrote {}", gif_path.display());
     }
     if let (Some(mut child), Some(p)) = (ffmpeg, mp4_pending) {
@@ -336,7 +287,7 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         if !status.success() {
             bail!("ffmpeg failed ({status}); no MP4 written");
         }
-        p.commit()?;
+        p.commit().with_context(|| format!("writing {}", mp4_path.display()))?;
         println!("wrote {}", mp4_path.display());
     }
     if o.png {

@@ -5,29 +5,16 @@ use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Instant;
-use sylva_core::methods::akagi::{Akagi, AkagiParams};
-use sylva_core::methods::hsm::{Hsm, HsmParams};
-use sylva_core::methods::skjermo::{Skjermo, SkjermoParams};
-use sylva_core::methods::zioma::{Lod, Zioma, ZiomaParams};
+use sylva_core::io::PendingFile;
+use sylva_core::methods::{Animator, MethodOptions};
 use sylva_core::pose::{Pose, displacement};
 use sylva_core::species::{DEFAULT_SPECIES, SpeciesSource};
 use sylva_core::wind::WindScene;
 use sylva_core::{Limits, Tree};
-
-/// Animation methods available.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    /// Zioma (GPU Gems 3 ch. 6): procedural, stateless.
-    Zioma,
-    /// Akagi & Kitajima §2.5: wind forces propagated to the root, damped angular springs.
-    Akagi,
-    /// Skjermo §4: one Bézier per stem, re-attached and bent by the wind each step.
-    Skjermo,
-    /// Song et al.: hierarchical shape matching, every segment and leaf a cluster of
-    /// particles (CPU only so far).
-    Hsm,
-}
+use sylva_gpu::methods::GpuAnimator;
+use sylva_runtime::{BUILTIN, MethodRegistry};
 
 /// Where to run.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,11 +35,26 @@ pub struct TreeWindArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Animation method.
-    #[arg(long, value_enum, default_value = "zioma")]
-    pub method: Method,
+    #[arg(long, default_value = "zioma", value_parser = clap::builder::PossibleValuesParser::new(BUILTIN.map(|e| e.name)))]
+    pub method: String,
     /// A wind preset (`gusty`, `blast`) or a scene TOML file.
     #[arg(long, default_value = "gusty")]
     pub wind: String,
+    /// A method parameter as `name=value` (TOML value: `damping_ratio=0.1`, `lod="trunk_only"`);
+    /// repeat for several. The names are the method's `Params` fields.
+    #[arg(long = "param", value_parser = parse_param)]
+    pub params: Vec<(String, toml::Value)>,
+}
+
+/// `name=value` with a TOML value (a bare word is a string).
+fn parse_param(s: &str) -> Result<(String, toml::Value), String> {
+    let (k, v) = s.split_once('=').ok_or_else(|| format!("`{s}`: expected name=value, e.g. damping_ratio=0.1"))?;
+    let v = v.trim();
+    let value = toml::from_str::<toml::Table>(&format!("v = {v}"))
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(v.to_string()));
+    Ok((k.trim().to_string(), value))
 }
 
 impl TreeWindArgs {
@@ -60,6 +62,17 @@ impl TreeWindArgs {
     pub fn resolve(&self) -> Result<(Tree, WindScene)> {
         let tree = SpeciesSource::resolve(&self.species)?.generate(self.seed, &Limits::default(), None)?;
         Ok((tree, WindScene::resolve(&self.wind)?))
+    }
+
+    /// The method's options: the seed and the `--param`s.
+    pub fn options(&self) -> MethodOptions {
+        MethodOptions { seed: self.seed, params: self.params.iter().cloned().collect() }
+    }
+
+    /// The method's name with a capital (for reports).
+    pub fn method_title(&self) -> String {
+        let mut c = self.method.chars();
+        c.next().map_or(String::new(), |f| f.to_uppercase().chain(c).collect())
     }
 }
 
@@ -92,17 +105,6 @@ pub struct SimulateArgs {
 
 const MAX_FRAMES: f32 = 10_000_000.0;
 
-/// Removes a temporary file when dropped, unless it was renamed into place.
-struct TempFile(Option<PathBuf>);
-
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        if let Some(p) = self.0.take() {
-            let _ = std::fs::remove_file(p);
-        }
-    }
-}
-
 /// Runs the command.
 pub fn run(a: &SimulateArgs) -> Result<()> {
     if !(a.seconds.is_finite() && a.seconds > 0.0) {
@@ -122,111 +124,54 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     if let Some(&bad) = track.iter().find(|&&i| i >= n) {
         bail!("--track {bad}: the tree has {n} segments (0..{})", n - 1);
     }
-    if a.trunk_only && a.tree.method != Method::Zioma {
-        bail!("--trunk-only is Zioma's simulation LOD; {:?} has none", a.tree.method);
+    let mut options = a.tree.options();
+    if a.trunk_only {
+        options.params.insert("lod".into(), toml::Value::String("trunk_only".into()));
     }
-    let ctx = match a.backend {
-        Backend::Cpu => None,
+    let built = |e: sylva_core::methods::MethodError| {
+        let e = anyhow::Error::from(e);
+        if a.trunk_only { e.context("--trunk-only sets Zioma's simulation LOD (`lod = \"trunk_only\"`)") } else { e }
+    };
+    let registry = MethodRegistry::builtin();
+    let entry = *registry.entry(&a.tree.method)?;
+    let tree = Arc::new(tree);
+    enum Sim {
+        Cpu(Box<dyn Animator>),
+        Gpu(&'static sylva_gpu::GpuContext, Box<dyn GpuAnimator>),
+    }
+    let mut sim = match a.backend {
+        Backend::Cpu => {
+            let mut m = (entry.cpu)(tree.clone(), &options).map_err(built)?;
+            m.set_wind(Arc::new(wind.packed()));
+            Sim::Cpu(m)
+        }
         Backend::Gpu => {
             let ctx = sylva_gpu::GpuContext::shared()?;
             println!("GPU: {}", ctx.summary);
-            Some(ctx)
+            let build = entry.gpu.with_context(|| format!("method `{}` has no GPU twin", entry.name))?;
+            let gpu_wind = sylva_gpu::wind::GpuWind::from_scene(ctx, &wind)?;
+            let m = build(ctx, tree.clone(), &options, &gpu_wind, &[]).map_err(|e| match e {
+                sylva_gpu::methods::BuildError::Method(m) => built(m),
+                sylva_gpu::methods::BuildError::Gpu(g) => g.into(),
+            })?;
+            Sim::Gpu(ctx, m)
         }
     };
-    let (fields, waves) = wind.pack();
-    let (tree_ref, wind_ref) = (&tree, &wind);
-    // One closure per method and backend: (time, step since the last frame) → pose.
-    type Runner<'a> = Box<dyn FnMut(f32, f32) -> Result<Pose> + 'a>;
-    let mut runner: Runner<'_> = match (a.tree.method, ctx) {
-        (Method::Zioma, ctx) => {
-            let params = ZiomaParams {
-                lod: if a.trunk_only { Lod::TrunkOnly } else { Lod::Full },
-                seed: a.tree.seed,
-                ..Default::default()
-            };
-            let method = Zioma::new(tree_ref, params);
-            match ctx {
-                None => Box::new(move |t, _| Ok(method.pose_packed(tree_ref, &fields, &waves, t))),
-                Some(ctx) => {
-                    let g = sylva_gpu::pose::GpuZioma::new(ctx, tree_ref, &method, wind_ref)?;
-                    Box::new(move |t, _| Ok(g.pose(ctx, tree_ref, &method, t)?))
-                }
-            }
-        }
-        (Method::Akagi, None) => {
-            let method = Akagi::new(tree_ref, AkagiParams::default());
-            let mut state = method.rest_state(tree_ref);
-            Box::new(move |_, dt| {
-                if dt > 0.0 {
-                    method.step(tree_ref, &fields, &waves, &mut state, dt);
-                }
-                Ok(state.pose.clone())
-            })
-        }
-        (Method::Skjermo, None) => {
-            let method = Skjermo::new(tree_ref, SkjermoParams::default());
-            let mut state = method.rest_state(tree_ref);
-            Box::new(move |_, dt| {
-                if dt > 0.0 {
-                    method.step(tree_ref, &fields, &waves, &mut state, dt);
-                }
-                Ok(state.pose.clone())
-            })
-        }
-        (Method::Skjermo, Some(ctx)) => {
-            let method = Skjermo::new(tree_ref, SkjermoParams::default());
-            let mut g = sylva_gpu::pose::GpuSkjermo::new(ctx, tree_ref, &method, wind_ref)?;
-            Box::new(move |_, dt| {
-                if dt > 0.0 {
-                    g.step(ctx, dt);
-                }
-                Ok(g.read(ctx, &method)?)
-            })
-        }
-        (Method::Hsm, None) => {
-            let method = Hsm::new(tree_ref, HsmParams::default())?;
-            println!("hsm: {} clusters, {} particles", method.layout.cluster_count(), method.layout.particle_count());
-            let mut state = method.rest_state();
-            Box::new(move |_, dt| {
-                if dt > 0.0 {
-                    method.step(&fields, &waves, &mut state, dt);
-                }
-                Ok(method.pose(tree_ref, &state))
-            })
-        }
-        (Method::Hsm, Some(ctx)) => {
-            let method = Hsm::new(tree_ref, HsmParams::default())?;
-            println!("hsm: {} clusters, {} particles", method.layout.cluster_count(), method.layout.particle_count());
-            let mut g = sylva_gpu::hsm::GpuHsm::new(ctx, Some(tree_ref), &method, wind_ref)?;
-            Box::new(move |_, dt| {
-                if dt > 0.0 {
-                    g.step(ctx, &method, dt);
-                }
-                Ok(g.read_pose(ctx)?.expect("built with the tree"))
-            })
-        }
-        (Method::Akagi, Some(ctx)) => {
-            let method = Akagi::new(tree_ref, AkagiParams::default());
-            let mut g = sylva_gpu::pose::GpuAkagi::new(ctx, tree_ref, &method, wind_ref)?;
-            Box::new(move |_, dt| {
-                if dt > 0.0 {
-                    g.step(ctx, dt);
-                }
-                Ok(g.read(ctx)?)
-            })
-        }
+    let (particles, clusters) = match &sim {
+        Sim::Cpu(m) => (m.particles(), m.cluster_centres().map(|c| c.len())),
+        Sim::Gpu(ctx, m) => (m.particles(), m.cluster_centres(ctx)?.map(|c| c.len())),
     };
-
-    let mut guard = TempFile(None);
+    if let (Some(p), Some(c)) = (particles, clusters) {
+        println!("{}: {c} clusters, {p} particles", entry.name);
+    }
     let mut csv = match &a.csv {
         Some(p) => {
-            let tmp = p.with_extension("csv.tmp");
-            guard.0 = Some(tmp.clone());
+            let pending = PendingFile::new(p).with_context(|| format!("writing {}", p.display()))?;
             let mut f = std::io::BufWriter::new(
-                std::fs::File::create(&tmp).with_context(|| format!("creating {}", tmp.display()))?,
+                pending.create().with_context(|| format!("creating {}", pending.tmp().display()))?,
             );
             writeln!(f, "time_s,segment,level,x,y,z,dx,dy,dz")?;
-            Some((p.clone(), tmp, f))
+            Some((pending, f))
         }
         None => None,
     };
@@ -242,7 +187,17 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let dt = 1.0 / a.fps;
     for f in 0..frames {
         let t = f as f32 * dt;
-        let pose = runner(t, if f == 0 { 0.0 } else { dt })?;
+        let steps = if f == 0 { 0 } else { 1 };
+        let pose: Pose = match &mut sim {
+            Sim::Cpu(m) => {
+                m.advance(dt, steps);
+                m.pose()
+            }
+            Sim::Gpu(ctx, m) => {
+                m.advance(ctx, dt, steps);
+                m.read_pose(ctx)?
+            }
+        };
         let d = displacement(&tree, &pose);
         for l in 0..levels {
             sum_mean[l] += d.mean[l] as f64;
@@ -254,7 +209,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
                 max_speed = max_speed.max((ends[i] - p[i]).length() / dt);
             }
         }
-        if let Some((_, _, w)) = &mut csv {
+        if let Some((_, w)) = &mut csv {
             for &i in &track {
                 let r = tree.segments.end(i);
                 let e = ends[i];
@@ -276,17 +231,17 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     }
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
-    if let Some((path, tmp, w)) = csv {
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        std::fs::rename(&tmp, &path).with_context(|| format!("writing {}", path.display()))?;
-        guard.0 = None;
+    if let Some((pending, w)) = csv {
+        w.into_inner().map_err(|e| e.into_error())?;
+        let path = pending.path().to_path_buf();
+        pending.commit().with_context(|| format!("writing {}", path.display()))?;
         println!("wrote {} ({} tracked segments × {frames} frames)", path.display(), track.len());
     }
     println!(
-        "{} (seed {}), {:?} on {:?}, wind `{}`: {} frames over {} s in {:.2} s ({:.2} ms per frame)",
+        "{} (seed {}), {} on {:?}, wind `{}`: {} frames over {} s in {:.2} s ({:.2} ms per frame)",
         tree.name,
         tree.seed,
-        a.tree.method,
+        a.tree.method_title(),
         a.backend,
         a.tree.wind,
         frames,

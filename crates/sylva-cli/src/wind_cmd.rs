@@ -8,10 +8,9 @@ use anyhow::{Context, Result, bail};
 use glam::Vec3;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
+use sylva_bench::plot::atomic_png;
 use sylva_core::wind::WindScene;
-use sylva_core::wind::sample as wind_sample;
-
-pub(crate) const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+use sylva_core::wind::sample::wind_sample;
 
 /// Picks one curve's value from (velocity, speed).
 type Component = Box<dyn Fn(&[f32; 4], f32) -> f32>;
@@ -67,7 +66,7 @@ fn sample(scene: &WindScene, backend: &str, samples: &[[f32; 4]]) -> Result<Vec<
         }
         "gpu" => {
             let ctx = sylva_gpu::GpuContext::shared()?;
-            Ok(sylva_gpu::wind_sample::WindSampler::new(ctx, scene)?.sample(ctx, samples)?)
+            Ok(sylva_gpu::wind::WindSampler::new(ctx, scene)?.sample(ctx, samples)?)
         }
         other => bail!("--backend must be `cpu` or `gpu`, not `{other}`"),
     }
@@ -83,35 +82,12 @@ pub fn run(args: &WindArgs) -> Result<[PathBuf; 2]> {
     }
     let scene = WindScene::resolve(&args.scene)?;
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("creating {}", args.out_dir.display()))?;
-    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    sylva_bench::plot::register_font();
     let speed = args.out_dir.join("wind_speed.png");
     let field = args.out_dir.join("wind_field.png");
     speed_plot(&scene, args, &speed)?;
     field_map(&scene, args, &field)?;
     Ok([speed, field])
-}
-
-/// Renders into a temporary file beside `path`, then renames it: complete or absent.
-fn atomic_png(
-    path: &Path,
-    size: (u32, u32),
-    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>) -> Result<()>,
-) -> Result<()> {
-    let tmp = path.with_extension("tmp.png");
-    let result = (|| {
-        let root = BitMapBackend::new(&tmp, size).into_drawing_area();
-        root.fill(&WHITE)?;
-        draw(&root)?;
-        root.present()?;
-        Ok(())
-    })();
-    match result {
-        Ok(()) => std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display())),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
-    }
 }
 
 fn speed_plot(scene: &WindScene, a: &WindArgs, path: &Path) -> Result<()> {

@@ -152,42 +152,44 @@ fn render_rejects_bad_scenes_naming_the_problem() {
     assert!(!dir.path().join("out").exists());
 }
 
-/// An interrupted render (Ctrl-C) stops cleanly: no GIF, no temporary files; the frames
-/// written so far are complete PNGs.
+/// An interrupted render (Ctrl-C, and SIGTERM or SIGHUP from a session manager) stops
+/// cleanly: no GIF, no temporary files; the frames written so far are complete PNGs.
 #[cfg(unix)]
 #[test]
-fn interrupted_render_leaves_no_partial_output() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("tiny.toml"), TINY_SCENE).unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_sylva"))
-        .current_dir(dir.path())
-        .args(["render", "tiny.toml"])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let third = dir.path().join("out/frames/tiny_0002.png");
-    let start = std::time::Instant::now();
-    while !third.exists() {
-        assert!(start.elapsed().as_secs() < 300, "no frames after 300 s");
-        assert!(child.try_wait().unwrap().is_none(), "render ended before it was interrupted");
-        std::thread::sleep(std::time::Duration::from_millis(20));
+fn interrupted_render_leaves_no_partial_output_on_int_term_and_hup() {
+    for signal in ["INT", "TERM", "HUP"] {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("tiny.toml"), TINY_SCENE).unwrap();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_sylva"))
+            .current_dir(dir.path())
+            .args(["render", "tiny.toml"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let third = dir.path().join("out/frames/tiny_0002.png");
+        let start = std::time::Instant::now();
+        while !third.exists() {
+            assert!(start.elapsed().as_secs() < 300, "no frames after 300 s");
+            assert!(child.try_wait().unwrap().is_none(), "render ended before it was interrupted");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let killed = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
+        assert!(killed.success());
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "SIG{signal}: an interrupted render must fail");
+        assert!(err.contains("interrupted"), "SIG{signal}: {err}");
+        assert!(!dir.path().join("out/tiny.gif").exists(), "SIG{signal}: a partial GIF was left");
+        for e in std::fs::read_dir(dir.path().join("out"))
+            .unwrap()
+            .chain(std::fs::read_dir(dir.path().join("out/frames")).unwrap())
+        {
+            let name = e.unwrap().file_name().to_string_lossy().into_owned();
+            assert!(!name.contains(".tmp"), "SIG{signal}: temporary file {name} left");
+        }
+        image::open(&third).expect("frames written before the interrupt are complete");
     }
-    let killed = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
-    assert!(killed.success());
-    let out = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "an interrupted render must fail");
-    assert!(err.contains("interrupted"), "{err}");
-    assert!(!dir.path().join("out/tiny.gif").exists(), "a partial GIF was left");
-    for e in std::fs::read_dir(dir.path().join("out"))
-        .unwrap()
-        .chain(std::fs::read_dir(dir.path().join("out/frames")).unwrap())
-    {
-        let name = e.unwrap().file_name().to_string_lossy().into_owned();
-        assert!(!name.contains(".tmp"), "temporary file {name} left");
-    }
-    image::open(&third).expect("frames written before the interrupt are complete");
 }
 
 #[test]

@@ -9,7 +9,6 @@
 //! file, `STEPS=` default 1000; each tree cut to its first 150 clusters, as the GPU parity
 //! test does).
 
-use sylva_core::methods::Method;
 use sylva_core::methods::hsm::{Hsm, HsmLayout, HsmParams};
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;

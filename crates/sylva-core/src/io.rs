@@ -3,31 +3,77 @@
 
 use std::fs;
 use std::io::{self, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// Writes a file atomically: the content goes to a temporary file beside `path`, which is
-/// renamed over `path` only once it is complete. On any error the temporary file is removed
-/// and `path` is left as it was.
-pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let name =
-        path.file_name().ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "output path has no file name"))?;
-    let tmp = dir.join(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
-    let result = (|| {
-        let file = fs::File::create(&tmp)?;
-        let mut w = io::BufWriter::new(file);
-        fill(&mut w)?;
-        let file = w.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
-        fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
+/// An output file written completely or not at all: the content goes to a temporary file
+/// beside `path` (`.NAME.tmp-PID.EXT`, the extension kept last for encoders that choose the
+/// format by it), renamed over `path` by [`PendingFile::commit`]. Dropped uncommitted (an
+/// error, an interrupt), the temporary file is removed and `path` is left as it was.
+#[derive(Debug)]
+pub struct PendingFile {
+    tmp: PathBuf,
+    path: PathBuf,
+    done: bool,
+}
+
+impl PendingFile {
+    /// A pending file for `path` (nothing is created yet: write [`Self::tmp`]).
+    pub fn new(path: &Path) -> io::Result<Self> {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        let name = path
+            .file_name()
+            .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "output path has no file name"))?
+            .to_string_lossy();
+        let tmp = match path.extension() {
+            Some(ext) => dir.join(format!(".{name}.tmp-{}.{}", std::process::id(), ext.to_string_lossy())),
+            None => dir.join(format!(".{name}.tmp-{}", std::process::id())),
+        };
+        Ok(Self { tmp, path: path.to_path_buf(), done: false })
     }
-    result
+
+    /// Where the content goes until it is committed.
+    pub fn tmp(&self) -> &Path {
+        &self.tmp
+    }
+
+    /// The final path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Creates the temporary file for writing.
+    pub fn create(&self) -> io::Result<fs::File> {
+        fs::File::create(&self.tmp)
+    }
+
+    /// Flushes the temporary file to disk and renames it over the final path.
+    pub fn commit(mut self) -> io::Result<()> {
+        fs::File::open(&self.tmp)?.sync_all()?;
+        fs::rename(&self.tmp, &self.path)?;
+        self.done = true;
+        Ok(())
+    }
+}
+
+impl Drop for PendingFile {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Writes a file atomically ([`PendingFile`]): `fill` writes the content; on any error the
+/// temporary file is removed and `path` is left as it was.
+pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> io::Result<()> {
+    let pending = PendingFile::new(path)?;
+    let mut w = io::BufWriter::new(pending.create()?);
+    fill(&mut w)?;
+    w.into_inner().map_err(|e| e.into_error())?;
+    pending.commit()
 }
 
 /// Largest preset or grammar file read, bytes.

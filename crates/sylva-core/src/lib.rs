@@ -1,5 +1,5 @@
-//! Sylva core: the tree model, its generators, and (as they land) wind fields,
-//! animation methods and CPU meshing.
+//! Sylva core: the tree model, its generators, wind fields, the animation methods and their
+//! CPU kernels, meshing and export.
 //!
 //! This crate never depends on a GPU API. Every stage here is the CPU reference that the
 //! `sylva-gpu` crate's WGSL kernels are held to.
@@ -9,10 +9,19 @@
 //! * [`model`]: the one tree representation all methods and meshers consume
 //!   (structure of arrays, topological order, flat child lists, `Pod` raw twins for upload).
 //! * [`generate`]: parametric L-systems (Song §3, ABOP ch. 1–2) and Weber–Penn trees
-//!   (Weber & Penn 1995; Skjermo §2.1).
-//! * [`species`]: the presets shipped in `presets/` and loading of user files.
-//! * [`export`]: static OBJ output, written atomically.
-//! * [`simd`]: eight-lane vectors for the CPU fast paths, with AVX2 where the CPU has it.
+//!   (Weber & Penn 1995; Skjermo §2.1); [`species`]: the presets shipped in `presets/` and
+//!   loading of user files.
+//! * [`wind`]: wind fields, packed for the kernels, sampled one point or sixteen at a time.
+//! * [`physics`]: the tree as a mechanical body (air, drag, a joint's radius, a stem's load).
+//! * [`methods`]: the method seam ([`methods::Method`], [`methods::Animator`]) and one folder
+//!   per method (Zioma, Akagi, Skjermo, HSM) with its parameters, GPU-layout types, CPU
+//!   kernels and fast forms.
+//! * [`pose`]: the seam's output (joints and accumulated rotations), forward kinematics,
+//!   placements of instances, curves for the deformer.
+//! * [`mesh`]: per-frame meshing, skinning and Skjermo's deformer, with their CPU kernels.
+//! * [`export`]: OBJ and glTF, baked clips; [`io`]: files read with limits and written
+//!   completely or not at all; [`scene`]: scene files.
+//! * [`simd`]: sixteen-lane vectors for the CPU fast paths, run with AVX2 where the CPU has it.
 
 pub mod export;
 pub mod generate;

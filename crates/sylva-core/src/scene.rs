@@ -486,8 +486,15 @@ impl Scene {
         for (i, t) in self.trees.iter().enumerate() {
             let f = |k: &str| format!("tree[{i}].{k}");
             let m = t.method.as_str();
-            if m.is_empty() || m.len() > 64 || !m.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_') {
-                return err(&f("method"), format!("{m:?}"), "a method name (zioma, akagi, skjermo, hsm or one registered)");
+            if m.is_empty()
+                || m.len() > 64
+                || !m.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+            {
+                return err(
+                    &f("method"),
+                    format!("{m:?}"),
+                    "a method name (zioma, akagi, skjermo, hsm or one registered)",
+                );
             }
             if !glam::Vec3::from_array(t.position).is_finite() {
                 return err(&f("position"), format!("{:?}", t.position), "finite coordinates");

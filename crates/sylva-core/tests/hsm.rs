@@ -242,7 +242,7 @@ fn a_cantilever_sags_the_same_whatever_the_substeps() {
 /// stochastic bush (3 cm stems of 8 GPa wood, ~50× stiffer than a 240 Hz step holds that
 /// way) lay down in gusty wind: segment ends 2.0 m from rest on a 2.3 m bush, and with a
 /// tenth of the wood's stiffness it bent *less* (1.4 m). With the mean weighted by `k h²`
-/// (see `cpu::hsm::MAX_WEIGHT`), its segment ends stay within a tenth of its height, and
+/// (see `kernels::MAX_WEIGHT`), its segment ends stay within a tenth of its height, and
 /// softer wood bends it more.
 #[test]
 fn a_stiff_bush_does_not_lie_down_in_gusty_wind() {
@@ -296,7 +296,7 @@ fn still_air_keeps_the_exact_rest_pose() {
         let mut s = h.state_at_rest();
         let rest = s.clone();
         for _ in 0..60 {
-            h.step(&t, &&WindScene::default().packed(), &mut s, 1.0 / 60.0);
+            h.step(&t, &WindScene::default().packed(), &mut s, 1.0 / 60.0);
         }
         assert_eq!(s.displacement, rest.displacement, "{name}");
         assert_eq!(h.pose(&t, &PackedWind::calm(), &s), Pose::rest(&t), "{name}");
@@ -381,7 +381,7 @@ fn hsm_is_identical_on_any_thread_count() {
         rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap().install(|| {
             let mut s = h.state_at_rest();
             for _ in 0..60 {
-                h.step(&t, &&wind.packed(), &mut s, 1.0 / 60.0);
+                h.step(&t, &wind.packed(), &mut s, 1.0 / 60.0);
             }
             s
         })
@@ -403,7 +403,7 @@ fn fused_particle_stages_match_the_four_stages_exactly() {
         let h = Hsm::from_layout(&t, params, layout.clone());
         let mut s = h.state_at_rest();
         for _ in 0..120 {
-            h.step(&t, &&wind.packed(), &mut s, 1.0 / 60.0);
+            h.step(&t, &wind.packed(), &mut s, 1.0 / 60.0);
         }
         s
     };
@@ -596,7 +596,7 @@ fn the_state_holds_displacements_and_fixed_particles_never_move() {
     let wind = storm(30.0);
     let mut s = h.state_at_rest();
     for _ in 0..240 {
-        h.step(&t, &&wind.packed(), &mut s, 1.0 / 60.0);
+        h.step(&t, &wind.packed(), &mut s, 1.0 / 60.0);
     }
     let positions = h.positions(&s);
     assert_eq!(positions.len(), l.particle_count());

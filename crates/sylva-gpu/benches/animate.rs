@@ -6,6 +6,7 @@
 //! Run: `WGPU_BACKEND=vulkan cargo bench -p sylva-gpu --bench animate`. The papers' tables
 //! (Zioma's instancing, Skjermo's branch updates, …) are `sylva bench`.
 
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 use sylva_core::methods::Method;
 use sylva_core::methods::akagi::{Akagi, AkagiParams};
@@ -13,8 +14,10 @@ use sylva_core::methods::zioma::{Zioma, ZiomaParams};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 use sylva_gpu::GpuContext;
+use sylva_gpu::methods::GpuAnimator;
 use sylva_gpu::methods::akagi::GpuAkagi;
 use sylva_gpu::methods::zioma::GpuZioma;
+use sylva_gpu::wind::GpuWind;
 
 fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
@@ -58,10 +61,11 @@ fn main() {
             std::hint::black_box(z.pose_at(&t, &wind.packed(), tt));
         });
         let gpu = ctx.map(|c| {
-            let mut g = GpuZioma::new(c, &t, &z, &wind).unwrap();
+            let mut g =
+                GpuZioma::new(c, Arc::new(t.clone()), z.clone(), &GpuWind::from_scene(c, &wind).unwrap()).unwrap();
             time(9, || {
                 tt += 1.0 / 60.0;
-                std::hint::black_box(g.pose(c, &t, &z, tt).unwrap());
+                std::hint::black_box(g.pose(c, tt).unwrap());
             })
         });
         row(name, n, "zioma", rate(cpu, 1.0), gpu.map(|g| rate(g, 1.0)));
@@ -74,12 +78,12 @@ fn main() {
             }
         });
         let gpu = ctx.map(|c| {
-            let mut g = GpuAkagi::new(c, &t, &a, &wind).unwrap();
+            let mut g = GpuAkagi::new(c, Arc::new(t.clone()), &a, &GpuWind::from_scene(c, &wind).unwrap()).unwrap();
             time(3, || {
                 for _ in 0..60 {
                     g.step(c, 1.0 / 60.0);
                 }
-                std::hint::black_box(g.read(c).unwrap());
+                std::hint::black_box(g.read_pose(c).unwrap());
             })
         });
         row(name, n, "akagi", rate(cpu, 60.0), gpu.map(|g| rate(g, 60.0)));

@@ -8,7 +8,6 @@
 
 use criterion::{Criterion, Throughput, criterion_group};
 use std::time::{Duration, Instant};
-use sylva_core::methods::Method;
 use sylva_core::wind::WindScene;
 use sylva_gpu::GpuContext;
 use sylva_gpu::wind::WindSampler;
@@ -69,7 +68,8 @@ fn summary() {
     let fieldswaves = scene().packed();
     let mut out = vec![[0.0f32; 4]; N];
     cpu_once(&fieldswaves.fields, &fieldswaves.waves, &s, &mut out);
-    let (cpu, cpu_lo, cpu_hi) = median((0..7).map(|_| cpu_once(&fieldswaves.fields, &fieldswaves.waves, &s, &mut out)).collect());
+    let (cpu, cpu_lo, cpu_hi) =
+        median((0..7).map(|_| cpu_once(&fieldswaves.fields, &fieldswaves.waves, &s, &mut out)).collect());
     let rate = |d: Duration| N as f64 / d.as_secs_f64() / 1e6;
     println!("\nwind samples, {N} per run, `gusty` scene, {} CPU threads", rayon::current_num_threads());
     println!(

@@ -9,8 +9,8 @@ use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
 use sylva_gpu::methods::GpuAnimator;
-use sylva_gpu::wind::GpuWind;
 use sylva_gpu::methods::akagi::GpuAkagi;
+use sylva_gpu::wind::GpuWind;
 
 /// Joint positions within 1e-4 × tree height after 1,000 steps at 60 Hz in gusty wind: both
 /// sides run the same f32 operations in the same order (children summed in index order).

@@ -2,17 +2,17 @@
 
 mod common;
 
-use std::sync::Arc;
 use glam::{Quat, Vec3};
 use rand::{Rng, SeedableRng};
+use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::methods::zioma::{Zioma, ZiomaParams};
 use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
-use sylva_gpu::wind::GpuWind;
-use sylva_gpu::pose::{FkStrategy, GpuPose};
 use sylva_gpu::methods::zioma::GpuZioma;
+use sylva_gpu::pose::{FkStrategy, GpuPose};
+use sylva_gpu::wind::GpuWind;
 
 /// The angle between two nearby unit quaternions: |q₁ − q₂| ≈ half of it (acos near 1
 /// cannot resolve 1e-4 rad in f32).
@@ -111,7 +111,8 @@ fn zioma_matches_on_every_preset_at_random_times() {
     for p in PRESETS {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
         let z = Zioma::new(&t, ZiomaParams::default());
-        let mut gpu = GpuZioma::new(ctx, Arc::new(t.clone()), z.clone(), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
+        let mut gpu =
+            GpuZioma::new(ctx, Arc::new(t.clone()), z.clone(), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
         let mut worst = 0.0f32;
         for _ in 0..3 {
             let time = rng.random_range(0.0..120.0);
@@ -146,11 +147,19 @@ fn zioma_instances_match_and_sway_independently() {
     let z = Zioma::new(&t, ZiomaParams::default());
     let mut instances = ZiomaInstance::grid(37, 6.0, 9);
     instances[0] = ZiomaInstance::default();
-    let mut gpu = GpuZioma::with_instances(ctx, Arc::new(t.clone()), z.clone(), &GpuWind::from_scene(ctx, &wind).unwrap(), &instances).unwrap();
+    let mut gpu = GpuZioma::with_instances(
+        ctx,
+        Arc::new(t.clone()),
+        z.clone(),
+        &GpuWind::from_scene(ctx, &wind).unwrap(),
+        &instances,
+    )
+    .unwrap();
     let mut rng = rand::rngs::StdRng::seed_from_u64(13);
     for _ in 0..3 {
         let time = rng.random_range(0.0..60.0);
-        let cpu = Pose::from_rotations_instances(&t, &z.rotations_instances(&t, &fw.fields, &fw.waves, time, &instances));
+        let cpu =
+            Pose::from_rotations_instances(&t, &z.rotations_instances(&t, &fw.fields, &fw.waves, time, &instances));
         let got = gpu.poses(ctx, time).unwrap();
         assert_eq!(cpu.len(), instances.len());
         assert_eq!(got.len(), instances.len());

@@ -3,17 +3,17 @@
 
 mod common;
 
-use std::sync::Arc;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
-use sylva_core::methods::Method;
+use std::sync::Arc;
 use sylva_core::Tree;
+use sylva_core::methods::Method;
 use sylva_core::methods::hsm::{Hsm, HsmLayout, HsmParams, HsmState};
 use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::{PackedWind, WindScene};
-use sylva_gpu::wind::GpuWind;
 use sylva_gpu::methods::hsm::GpuHsm;
+use sylva_gpu::wind::GpuWind;
 
 fn tree(name: &str) -> Tree {
     SpeciesSource::resolve(name).unwrap().generate(1, &Default::default(), None).unwrap()
@@ -54,7 +54,9 @@ fn hsm_one_substep_matches_from_random_states() {
             c.rotation = glam::Quat::from_axis_angle(axis, rng.random_range(-0.5..0.5)).to_array();
         }
         state.time = rng.random_range(0.0..100.0);
-        let mut gpu = GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
+        let mut gpu =
+            GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap())
+                .unwrap();
         gpu.write_state(ctx, &state);
         let mut cpu = state.clone();
         h.step_packed(&fw.fields, &fw.waves, &mut cpu, 1.0 / 240.0);
@@ -96,7 +98,9 @@ fn hsm_matches_after_1000_steps_on_every_preset() {
         let params = HsmParams { substeps: 1, ..Default::default() };
         let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(150)).unwrap());
         let mut cpu = h.state_at_rest();
-        let mut gpu = GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
+        let mut gpu =
+            GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap())
+                .unwrap();
         for _ in 0..1000 {
             h.step_packed(&fw.fields, &fw.waves, &mut cpu, 1.0 / 240.0);
         }
@@ -126,7 +130,9 @@ fn hsm_whole_trees_match_on_the_gpu() {
         let t = tree(name);
         let h = Hsm::new(&t, HsmParams::default()).unwrap();
         let mut cpu = h.state_at_rest();
-        let mut gpu = GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
+        let mut gpu =
+            GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap())
+                .unwrap();
         for _ in 0..30 {
             h.step_packed(&fw.fields, &fw.waves, &mut cpu, 1.0 / 60.0);
             gpu.step(ctx, 1.0 / 60.0);
@@ -144,7 +150,8 @@ fn hsm_on_the_gpu_stays_at_rest_in_still_air() {
     let Some(ctx) = common::gpu() else { return };
     let t = tree("stochastic_bush");
     let h = Hsm::new(&t, HsmParams::default()).unwrap();
-    let mut gpu = GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::calm(ctx).unwrap()).unwrap();
+    let mut gpu =
+        GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::calm(ctx).unwrap()).unwrap();
     assert_eq!(gpu.read_pose(ctx).unwrap().unwrap(), Pose::rest(&t));
     gpu.advance_steps(ctx, 1.0 / 60.0, 20);
     let g = gpu.read_state(ctx).unwrap();

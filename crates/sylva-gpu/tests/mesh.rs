@@ -3,20 +3,20 @@
 
 mod common;
 
-use std::sync::Arc;
 use glam::{Quat, Vec3};
 use rand::{Rng, SeedableRng};
-use sylva_core::methods::Method;
+use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::mesh::{MeshFrame, MeshLayout, MeshParams};
+use sylva_core::methods::Method;
 use sylva_core::methods::zioma::{Zioma, ZiomaParams};
 use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
-use sylva_gpu::methods::GpuAnimator;
-use sylva_gpu::wind::GpuWind;
 use sylva_gpu::mesh::GpuMesh;
+use sylva_gpu::methods::GpuAnimator;
 use sylva_gpu::methods::zioma::GpuZioma;
+use sylva_gpu::wind::GpuWind;
 
 fn random_pose(t: &Tree, rng: &mut rand::rngs::StdRng) -> Pose {
     let delta: Vec<[f32; 4]> = (0..t.segments.len())
@@ -76,7 +76,8 @@ fn gpu_mesh_reads_a_gpu_methods_pose_without_a_round_trip() {
     let t = SpeciesSource::resolve("sassafras").unwrap().generate(4, &Default::default(), None).unwrap();
     let wind = WindScene::resolve("gusty").unwrap();
     let method = Zioma::new(&t, ZiomaParams::default());
-    let mut g = GpuZioma::new(ctx, Arc::new(t.clone()), method.clone(), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
+    let mut g =
+        GpuZioma::new(ctx, Arc::new(t.clone()), method.clone(), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
     let layout = MeshLayout::new(&t, MeshParams::default()).unwrap();
     let mesh = GpuMesh::new(ctx, &layout).unwrap();
     for time in [0.7f32, 3.1] {

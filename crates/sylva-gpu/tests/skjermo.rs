@@ -8,8 +8,8 @@ use sylva_core::methods::skjermo::{Skjermo, SkjermoParams};
 use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::WindScene;
-use sylva_gpu::wind::GpuWind;
 use sylva_gpu::methods::skjermo::GpuSkjermo;
+use sylva_gpu::wind::GpuWind;
 
 /// Joint positions and control points within 1e-4 × tree height after 1,000 steps at 60 Hz
 /// in gusty wind.

@@ -7,10 +7,10 @@
 use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use sylva_runtime::World;
 use sylva_runtime::sylva_core::scene::Scene;
 use sylva_runtime::sylva_gpu::GpuContext;
 use sylva_runtime::sylva_gpu::render::{Camera, Lighting, RenderSettings, Renderer};
-use sylva_runtime::World;
 
 /// The scene: an aspen by Zioma's method with two copies, a palm by Akagi's, in gusty wind.
 const SCENE: &str = r#"
@@ -44,7 +44,11 @@ fn app_device() -> Result<(wgpu::Instance, wgpu::Adapter, wgpu::Device, wgpu::Qu
 }
 
 /// Renders `frames` frames of the scene into `out` (`frame_0000.png`, …); returns the files.
-fn run(device: (wgpu::Instance, wgpu::Adapter, wgpu::Device, wgpu::Queue), out: &Path, frames: usize) -> Result<Vec<PathBuf>, Box<dyn Error>> {
+fn run(
+    device: (wgpu::Instance, wgpu::Adapter, wgpu::Device, wgpu::Queue),
+    out: &Path,
+    frames: usize,
+) -> Result<Vec<PathBuf>, Box<dyn Error>> {
     let (instance, adapter, device, queue) = device;
     let ctx = Arc::new(GpuContext::from_wgpu(Some(instance), adapter, device, queue));
     let scene = Scene::from_toml(SCENE, "headless.rs scene", Path::new("."))?;

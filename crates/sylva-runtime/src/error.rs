@@ -8,7 +8,7 @@ use sylva_core::scene::SceneError;
 pub enum RuntimeError {
     /// The scene file.
     #[error(transparent)]
-    Scene(#[from] SceneError),
+    Scene(Box<SceneError>),
     /// A tree's species or grammar.
     #[error("{file}: field `tree[{index}].species`: {source}")]
     Species {
@@ -17,7 +17,7 @@ pub enum RuntimeError {
         /// The tree's index.
         index: usize,
         /// Why the species did not load or grow.
-        source: sylva_core::species::SpeciesError,
+        source: Box<sylva_core::species::SpeciesError>,
     },
     /// A tree's method and its parameters.
     #[error("{file}:{line}: tree[{index}]: {source}")]
@@ -29,7 +29,7 @@ pub enum RuntimeError {
         /// The tree's index.
         index: usize,
         /// What the method refused.
-        source: MethodError,
+        source: Box<MethodError>,
     },
     /// The scene's wind.
     #[error("{file}: field `wind`: {source}")]
@@ -37,7 +37,7 @@ pub enum RuntimeError {
         /// The scene file.
         file: String,
         /// Why the wind did not load.
-        source: sylva_core::wind::WindError,
+        source: Box<sylva_core::wind::WindError>,
     },
     /// Meshing.
     #[error(transparent)]
@@ -67,4 +67,10 @@ pub enum RuntimeError {
         /// The method.
         method: String,
     },
+}
+
+impl From<SceneError> for RuntimeError {
+    fn from(e: SceneError) -> Self {
+        Self::Scene(Box::new(e))
+    }
 }

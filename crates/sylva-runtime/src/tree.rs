@@ -12,8 +12,8 @@ use crate::registry::MethodRegistry;
 use crate::wind::{ClockWind, WorldWind};
 use glam::{Mat4, Quat, Vec3};
 use std::sync::Arc;
-use sylva_core::methods::{Animator, MethodOptions};
 use sylva_core::mesh::{DeformLayout, DeformerParams, MeshLayout, MeshParams, RawVertex, SkinLayout};
+use sylva_core::methods::{Animator, MethodOptions};
 use sylva_core::pose::{Placement, Pose, SeamPose};
 use sylva_core::scene::{BackendChoice, Scene, SceneTree};
 use sylva_core::species::SpeciesSource;
@@ -50,6 +50,13 @@ impl Simulation {
         match self {
             Self::Cpu(a) => a.advance(dt, steps),
             Self::Gpu(g) => g.advance(ctx, dt, steps),
+        }
+    }
+
+    fn reset(&mut self, ctx: &GpuContext, time: f32) {
+        match self {
+            Self::Cpu(a) => a.reset(time),
+            Self::Gpu(g) => g.reset(ctx, time),
         }
     }
 
@@ -251,11 +258,17 @@ impl WorldTree {
                 }
                 _ => format!("tree[{i}].method"),
             };
-            RuntimeError::Method { file: scene.file.clone(), line: scene.line_of(&field), index: i, source }
+            RuntimeError::Method {
+                file: scene.file.clone(),
+                line: scene.line_of(&field),
+                index: i,
+                source: Box::new(source),
+            }
         };
         let entry = *registry.entry(st.method.as_str()).map_err(method_error)?;
         let species = scene.resolve_path(&st.species);
-        let species_error = |source| RuntimeError::Species { file: scene.file.clone(), index: i, source };
+        let species_error =
+            |source| RuntimeError::Species { file: scene.file.clone(), index: i, source: Box::new(source) };
         let source = SpeciesSource::resolve(&species).map_err(species_error)?;
         let tree = Arc::new(source.generate(st.seed, &Limits::default(), None).map_err(species_error)?);
         let software = ctx.summary.device_type == "Cpu";
@@ -297,12 +310,12 @@ impl WorldTree {
         });
         let build_sim = |wind: &ClockWind, placements: &[Placement]| -> Result<Simulation, RuntimeError> {
             let mut sim = match (gpu, entry.gpu) {
-                (true, Some(build)) => Simulation::Gpu(build(ctx, tree.clone(), &options, &wind.gpu, placements).map_err(
-                    |e| match e {
+                (true, Some(build)) => {
+                    Simulation::Gpu(build(ctx, tree.clone(), &options, &wind.gpu, placements).map_err(|e| match e {
                         sylva_gpu::methods::BuildError::Method(m) => method_error(m),
                         sylva_gpu::methods::BuildError::Gpu(g) => RuntimeError::Gpu(g),
-                    },
-                )?),
+                    })?)
+                }
                 _ => Simulation::Cpu((entry.cpu)(tree.clone(), &options).map_err(method_error)?),
             };
             sim.set_wind(wind);
@@ -412,6 +425,16 @@ impl WorldTree {
             }
             Drawn::Forest(f) => f.sim.advance(ctx, dt, steps),
         }
+    }
+
+    /// Puts every simulation at rest at scene time `time` (a tree built while the world
+    /// runs), then pre-rolls each phase group by its lead.
+    pub(crate) fn start_at(&mut self, ctx: &GpuContext, dt: f32, time: f32) {
+        match &mut self.drawn {
+            Drawn::Groups(groups) => groups.iter_mut().for_each(|g| g.sim.reset(ctx, time)),
+            Drawn::Forest(f) => f.sim.reset(ctx, time),
+        }
+        self.advance(ctx, dt, 0, true);
     }
 
     /// Records the meshes of the current poses.

@@ -1,10 +1,10 @@
 //! The world: a scene's trees as they run, the wind they feel, the clock, and what the
 //! renderer draws.
 
+use crate::RuntimeError;
 use crate::registry::MethodRegistry;
 use crate::tree::WorldTree;
 use crate::wind::{Effect, WorldWind};
-use crate::RuntimeError;
 use glam::Vec3;
 use std::sync::Arc;
 use sylva_core::scene::{Scene, SceneTree};
@@ -44,7 +44,7 @@ impl World {
         }
         scene.check_methods(&registry.names())?;
         let base = WindScene::resolve(&scene.resolve_path(&scene.wind))
-            .map_err(|source| RuntimeError::SceneWind { file: scene.file.clone(), source })?;
+            .map_err(|source| RuntimeError::SceneWind { file: scene.file.clone(), source: Box::new(source) })?;
         let wind = WorldWind::new(&ctx, base)?;
         let mut world = Self { ctx, registry, scene, trees: Vec::new(), wind, time: 0.0, dt, carry: 0.0 };
         world.trees = world.build_all()?;
@@ -194,40 +194,40 @@ impl World {
         Ok(())
     }
 
-    /// Replaces tree `i` by `st` at the current time (its phase groups pre-rolled by their
-    /// leads). On an error the running tree is left as it was.
+    /// Replaces tree `i` by `st`, at rest at the current time (its phase groups pre-rolled
+    /// by their leads). On an error the running tree is left as it was.
     pub fn rebuild_tree(&mut self, i: usize, st: SceneTree) -> Result<(), RuntimeError> {
         if i >= self.trees.len() {
             return Err(RuntimeError::NoTree { index: i, trees: self.trees.len() });
         }
         let mut scene = self.scene.clone();
         scene.trees[i] = st;
-        scene.check().map_err(|(field, value, expected)| RuntimeError::Limit(format!("{field} = {value}: expected {expected}")))?;
+        scene.check().map_err(|(field, value, expected)| {
+            RuntimeError::Limit(format!("{field} = {value}: expected {expected}"))
+        })?;
         scene.check_methods(&self.registry.names())?;
         let st = scene.trees[i].clone();
         let mut tree = WorldTree::build(&self.ctx, &self.registry, &scene, i, &st, &mut self.wind, self.dt)?;
-        let steps = (self.time / self.dt).round() as usize;
-        tree.advance(&self.ctx, self.dt, steps, true);
+        tree.start_at(&self.ctx, self.dt, self.time);
         self.trees[i] = tree;
         self.scene = scene;
         Ok(())
     }
 
-    /// Replaces the whole scene (a reload): every tree rebuilt and brought to the current
-    /// time, the wind the new scene's plus the live effects. On an error the running world is
+    /// Replaces the whole scene (a reload): every tree rebuilt at rest at the current time,
+    /// the wind the new scene's plus the live effects. On an error the running world is
     /// left as it was.
     pub fn set_scene(&mut self, scene: Scene) -> Result<(), RuntimeError> {
         scene.check_methods(&self.registry.names())?;
         let base = WindScene::resolve(&scene.resolve_path(&scene.wind))
-            .map_err(|source| RuntimeError::SceneWind { file: scene.file.clone(), source })?;
+            .map_err(|source| RuntimeError::SceneWind { file: scene.file.clone(), source: Box::new(source) })?;
         let old_scene = std::mem::replace(&mut self.scene, scene);
         let old_base = std::mem::replace(&mut self.wind.base, base);
         let rebuilt = self.wind.recompose(&self.ctx).map_err(RuntimeError::from).and_then(|()| self.build_all());
         match rebuilt {
             Ok(mut trees) => {
-                let steps = (self.time / self.dt).round() as usize;
                 for t in &mut trees {
-                    t.advance(&self.ctx, self.dt, steps, true);
+                    t.start_at(&self.ctx, self.dt, self.time);
                 }
                 self.trees = trees;
                 Ok(())

@@ -95,6 +95,9 @@ impl Method for Rigid {
     fn time(&self, state: &RigidState) -> f32 {
         state.time
     }
+    fn set_time(&self, state: &mut RigidState, time: f32) {
+        state.time = time;
+    }
     fn seam(&self, tree: &Tree, _wind: &PackedWind, state: &RigidState, out: &mut SeamPose) {
         let q = root_rotation(state.lean).to_array();
         let delta: Vec<[f32; 4]> = (0..tree.segments.len())
@@ -211,10 +214,10 @@ impl GpuAnimator for GpuRigid {
     fn set_wind(&mut self, wind: &GpuWind) {
         self.wind = wind.clone();
     }
-    fn reset(&mut self, ctx: &GpuContext) {
+    fn reset(&mut self, ctx: &GpuContext, time: f32) {
         ctx.queue.write_buffer(&self.state, 0, bytemuck::cast_slice(&[[0.0f32; 4]]));
         self.pose.write_rest(ctx, &self.tree);
-        self.time = 0.0;
+        self.time = time;
     }
     fn advance(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
         let w0 = std::f32::consts::TAU * self.method.params.frequency;
@@ -236,9 +239,19 @@ impl GpuAnimator for GpuRigid {
             }
             let mut e = ctx.device.create_command_encoder(&Default::default());
             if live {
-                self.step_kernel.record(ctx, &mut e, &[&self.wind.fields, &self.wind.waves, &self.state, &self.step], 1);
+                self.step_kernel.record(
+                    ctx,
+                    &mut e,
+                    &[&self.wind.fields, &self.wind.waves, &self.state, &self.step],
+                    1,
+                );
             }
-            self.delta_kernel.record(ctx, &mut e, &[self.pose.parents_buffer(), &self.state, self.pose.delta_buffer()], n);
+            self.delta_kernel.record(
+                ctx,
+                &mut e,
+                &[self.pose.parents_buffer(), &self.state, self.pose.delta_buffer()],
+                n,
+            );
             self.pose.record(ctx, &mut e);
             ctx.queue.submit([e.finish()]);
         }
@@ -305,7 +318,8 @@ fn a_method_defined_outside_sylva_runs_through_the_runtime_on_cpu_and_gpu() {
         poses.push(pose);
     }
     // The two backends run the same oscillator: crowns agree within 1e-4 × height.
-    let t = sylva_core::species::SpeciesSource::resolve("palm").unwrap().generate(1, &Default::default(), None).unwrap();
+    let t =
+        sylva_core::species::SpeciesSource::resolve("palm").unwrap().generate(1, &Default::default(), None).unwrap();
     let tol = 1e-4 * t.height();
     for i in 0..t.segments.len() {
         let d = (poses[0].start[i] - poses[1].start[i]).length();
@@ -326,8 +340,8 @@ fn a_registered_method_reads_its_parameters_and_refuses_bad_ones_by_line() {
     };
     let (soft, stiff) = (lean("params = { gain = 0.004 }\n"), lean("params = { gain = 0.001 }\n"));
     assert!(stiff < 0.5 * soft, "stiff {stiff} m, soft {soft} m");
-    let e = World::with(ctx.clone(), scene("cpu", "params = { frequency = -1.0 }\n"), registry(), 1.0 / 60.0)
-        .unwrap_err();
+    let e =
+        World::with(ctx.clone(), scene("cpu", "params = { frequency = -1.0 }\n"), registry(), 1.0 / 60.0).unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, RuntimeError::Method { line: 8, .. }), "{msg}");
     assert!(msg.contains("rigid.toml:8") && msg.contains("frequency") && msg.contains("positive"), "{msg}");

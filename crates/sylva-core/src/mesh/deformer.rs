@@ -16,7 +16,7 @@
 //!
 //! Each frame reads the stems' control points as Skjermo's method keeps them (rest plus
 //! per-step displacement, [`crate::methods::skjermo`]). The CPU reference
-//! `cpu::skjermo_deform` is the twin of `skjermo_deform.wgsl` (one ring per work item).
+//! `mesh::skjermo_deform` is the twin of `skjermo_deform.wgsl` (one ring per work item).
 
 use super::{MIN_RADIUS_FRACTION, MeshError, RawMeshInfo};
 use crate::model::Tree;

@@ -1,4 +1,4 @@
-//! CPU twin of `shader/mesh_detail.wgsl`: one midpoint vertex of a subdivided band per work
+//! CPU twin of `mesh_detail.wgsl`: one midpoint vertex of a subdivided band per work
 //! item (Akagi §2.3). See [`crate::mesh`] for the construction.
 
 use crate::mesh::{RawDetail, RawMeshInfo, RawVertex, bark_relief};

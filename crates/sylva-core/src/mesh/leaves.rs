@@ -1,4 +1,4 @@
-//! CPU twin of `shader/mesh_leaves.wgsl`: one leaf-polygon vertex per work item (Akagi
+//! CPU twin of `mesh_leaves.wgsl`: one leaf-polygon vertex per work item (Akagi
 //! §2.4). See [`crate::mesh`] for the construction.
 
 use crate::mesh::{RawMeshInfo, RawVertex};

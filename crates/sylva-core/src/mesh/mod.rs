@@ -26,7 +26,7 @@
 //! `s` = depth × radius. A midpoint on a ring edge shared with a band that is not subdivided
 //! gets `s = 0` — exactly the edge's midpoint — so the surface has no cracks. The midpoint
 //! vertices ([`RawDetail`]) follow the ring vertices in the bark buffer and are computed from
-//! them by `cpu::mesh_detail` ↔ `mesh_detail.wgsl`, one per invocation.
+//! them by `mesh::mesh_detail` ↔ `mesh_detail.wgsl`, one per invocation.
 //!
 //! # Leaves (§2.4)
 //! From each leaf point a leaf polygon: the unit n-gon as two half-circles scaled by the
@@ -37,7 +37,7 @@
 //! The topology (index buffers, the ring table) is built once per tree by [`MeshLayout`];
 //! per frame only vertices are computed, from the pose as the GPU pose seam stores it
 //! (joint positions and accumulated rotations `D`, see [`crate::animate`]). The CPU
-//! references `cpu::mesh_tubes` and `cpu::mesh_leaves` are the twins of
+//! references `mesh::mesh_tubes` and `mesh::mesh_leaves` are the twins of
 //! `sylva-gpu`'s `mesh_tubes.wgsl` and `mesh_leaves.wgsl` (one invocation per vertex).
 
 pub mod deformer;
@@ -99,18 +99,6 @@ impl Default for MeshParams {
         }
     }
 }
-
-/// Akagi & Kitajima Table 2 (Core2 Extreme QX9650, GeForce GTX 280): (polygons, CPU
-/// single-thread generation + drawing, GPU generation + drawing), seconds per 1,000 frames.
-pub const AKAGI_TABLE_2: [(usize, f64, f64); 7] = [
-    (108_808, 1.27, 0.006),
-    (201_760, 2.58, 0.013),
-    (450_592, 6.52, 0.032),
-    (823_840, 12.45, 0.064),
-    (1_321_504, 20.38, 0.108),
-    (2_536_192, 39.79, 0.196),
-    (4_109_056, 65.28, 0.352),
-];
 
 /// Largest sides / samples accepted (bounds memory on user input).
 pub const MAX_SIDES: u32 = 64;

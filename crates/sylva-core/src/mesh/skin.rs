@@ -4,13 +4,13 @@
 //!
 //! Bones are segments; a bone's transform maps rest to pose rigidly,
 //! `x ↦ joint_b + D_b (x − rest_b)` (joint position, accumulated rotation, rest joint), the
-//! same transform that carries a leaf in [`crate::cpu::mesh_leaves`]. A bark vertex on a
+//! same transform that carries a leaf in [`crate::mesh::mesh_leaves`]. A bark vertex on a
 //! ring at parameter t of segment i blends segment i with its neighbour in the stem toward
 //! the nearer joint — weight ½ − t of the previous segment for t < ½, t − ½ of the next for
 //! t > ½ — so a joint ring is exactly half each and the skin bends smoothly there. A leaf
 //! vertex follows its segment alone.
 //!
-//! The CPU reference `cpu::skin_vertices` is the twin of `skin_vertices.wgsl`; both write
+//! The CPU reference `mesh::skin_vertices` is the twin of `skin_vertices.wgsl`; both write
 //! instance-major output (`instance × vertices + vertex`) from instance-major poses.
 
 use super::{MeshLayout, RawVertex};

@@ -1,4 +1,4 @@
-//! CPU twin of `shader/skin_vertices.wgsl`: linear blend skinning with two bones, one output
+//! CPU twin of `skin_vertices.wgsl`: linear blend skinning with two bones, one output
 //! vertex per work item, instance-major (Zioma §6.5; see [`crate::mesh::skin`]).
 
 use crate::mesh::{RawSkin, RawSkinInfo, RawVertex};

@@ -1,4 +1,4 @@
-//! CPU twin of `shader/skjermo_deform.wgsl`: Skjermo's deformer, one grid ring per work
+//! CPU twin of `skjermo_deform.wgsl`: Skjermo's deformer, one grid ring per work
 //! item (see [`crate::mesh::deformer`]).
 
 use crate::mesh::{RawDeformRing, RawDeformShape, RawMeshInfo, RawVertex, deform_radius};

@@ -1,4 +1,4 @@
-//! CPU twin of `shader/mesh_tubes.wgsl`: one bark vertex per work item (Akagi §2.2–2.3).
+//! CPU twin of `mesh_tubes.wgsl`: one bark vertex per work item (Akagi §2.2–2.3).
 //! See [`crate::mesh`] for the construction.
 
 use crate::mesh::{RawMeshInfo, RawRing, RawVertex, bark_relief, quat_slerp};

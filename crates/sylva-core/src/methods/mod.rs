@@ -76,13 +76,7 @@ impl MethodOptions {
 }
 
 /// A parameter check: `Err` naming the field, its value and what was expected.
-pub(crate) fn check(
-    method: &'static str,
-    field: &str,
-    value: f32,
-    ok: bool,
-    expected: &str,
-) -> Result<(), MethodError> {
+pub fn check(method: &'static str, field: &str, value: f32, ok: bool, expected: &str) -> Result<(), MethodError> {
     if ok && value.is_finite() {
         Ok(())
     } else {
@@ -106,6 +100,9 @@ pub trait Method: Debug + Send + Sync + 'static {
 
     /// Simulated time of `state`, s.
     fn time(&self, state: &Self::State) -> f32;
+
+    /// Sets the simulated time of `state` (a simulation started later than time 0).
+    fn set_time(&self, state: &mut Self::State, time: f32);
 
     /// The pose of `state` as the seam's buffers (one instance).
     fn seam(&self, tree: &Tree, wind: &PackedWind, state: &Self::State, out: &mut SeamPose);
@@ -156,8 +153,8 @@ pub trait Animator: Debug + Send + Sync {
     fn set_wind(&mut self, wind: Arc<PackedWind>);
     /// The wind it reads.
     fn wind(&self) -> &PackedWind;
-    /// Returns to the rest state at time 0.
-    fn reset(&mut self);
+    /// Returns to the rest state at `time`.
+    fn reset(&mut self, time: f32);
     /// Advances by `dt` seconds.
     fn step(&mut self, dt: f32);
     /// Advances `steps` steps of `dt` seconds.
@@ -232,8 +229,9 @@ impl<M: Method> Animator for Simulation<M> {
     fn wind(&self) -> &PackedWind {
         &self.wind
     }
-    fn reset(&mut self) {
+    fn reset(&mut self, time: f32) {
         self.state = self.method.rest_state(&self.tree);
+        self.method.set_time(&mut self.state, time);
     }
     fn step(&mut self, dt: f32) {
         self.method.step(&self.tree, &self.wind, &mut self.state, dt);

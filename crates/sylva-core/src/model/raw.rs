@@ -1,5 +1,5 @@
 //! `#[repr(C)]` `Pod` twins of the model, padded as WGSL lays out the matching structs
-//! (`sylva-gpu/src/shader/tree.wgsl`; a test there checks sizes and offsets with naga).
+//! (`sylva-gpu/src/wgsl/tree.wgsl`; a test there checks sizes and offsets with naga).
 
 use super::Tree;
 use bytemuck::{Pod, Zeroable};

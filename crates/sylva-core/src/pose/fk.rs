@@ -1,6 +1,6 @@
-//! CPU twins of `shader/pose_accumulate.wgsl` and `shader/pose_positions.wgsl`: forward
+//! CPU twins of `pose_accumulate.wgsl` and `pose_positions.wgsl`: forward
 //! kinematics by ancestor walks (see [`crate::animate`]). Every segment walks its own chain,
-//! in parallel, exactly as a GPU invocation does. `shader/pose_level.wgsl`'s twin,
+//! in parallel, exactly as a GPU invocation does. `pose_level.wgsl`'s twin,
 //! [`pose_level`], is the level-by-level alternative (one dispatch per depth).
 
 use crate::model::NONE;

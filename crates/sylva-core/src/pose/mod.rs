@@ -1,8 +1,6 @@
-//! Animation: a method turns (tree, wind, time, its own state) into a [`Pose`].
+//! The pose seam: what every method hands out, and forward kinematics.
 //!
-//! # The seam every method plugs into
-//!
-//! A method produces one rotation `δᵢ` per segment, a world-frame rotation about the
+//! A method ([`crate::methods`]) produces one rotation `δᵢ` per segment, a world-frame rotation about the
 //! segment's joint, expressed in the *rest* frame. The pose follows by forward kinematics:
 //!
 //! * accumulated rotation `Dᵢ = D_parent · δᵢ` (root: `Dᵢ = δᵢ`);
@@ -12,12 +10,14 @@
 //!
 //! Written as displacements, the rest pose is reproduced bit for bit when every `δ` is the
 //! identity (zero wind). Zioma's rule "per-branch angles → quaternions concatenated from the
-//! root down" is exactly `D`. The CPU (`cpu::pose_fk`) and GPU (`pose_accumulate.wgsl`,
+//! root down" is exactly `D`. The CPU ([`fk`]) and GPU (`pose_accumulate.wgsl`,
 //! `pose_positions.wgsl`) both let each segment walk its ancestor chain, so no pass waits on
 //! another level.
 //!
-//! A [`Pose`] is what meshers, renderers and exporters consume: per-segment world joint
-//! position and orientation, plus animated Bézier control points for methods that have them.
+//! The seam's buffers ([`SeamPose`]: joints and `D`, instance-major) are what meshers and
+//! skinning read; a [`Pose`] is the same with world orientations, plus animated Bézier
+//! control points for methods that have them. [`Placement`] places instances posed one by
+//! one; [`curves`] carries a curve-bending method's stems to the deformer.
 
 pub mod curves;
 pub mod fk;

@@ -1,4 +1,4 @@
-//! CPU twin of `shader/segment_ends.wgsl`.
+//! CPU twin of `segment_ends.wgsl`.
 
 use crate::model::RawSegment;
 use glam::{Quat, Vec3};

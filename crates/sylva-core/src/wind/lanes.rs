@@ -1,6 +1,6 @@
 //! The wind scene at sixteen points at once, for the CPU's lane paths (Skjermo's stems, the
 //! centres of HSM's clusters): [`crate::simd::F32x16`] lanes, a polynomial sine, and every field
-//! kind of `cpu::wind_sample::field_at` — constant, sum of sines and turbulence on the
+//! kind of `wind::sample::field_at` — constant, sum of sines and turbulence on the
 //! lanes, the localised events (gust front, vortex, blast) per lane through `field_at`.
 //! Agrees with `wind_at` to the sine's error (tested).
 
@@ -59,7 +59,7 @@ impl V3 {
         let l = self.length();
         let ok = l.cmp_gt(V::splat(1e-6));
         let safe = ok.blend(l, V::ONE);
-        // One reciprocal, as `animate::skjermo::unit_or`: the same rounding as the reference,
+        // One reciprocal, as `methods::skjermo::unit_or`: the same rounding as the reference,
         // so the rest frames it builds are reproduced bit for bit.
         Self::select(ok, self.scale(V::ONE / safe), fallback)
     }
@@ -134,7 +134,7 @@ pub fn powi(mut x: V, mut k: u32) -> V {
     r
 }
 
-/// The wind scene at sixteen points (as `cpu::wind_sample::wind_at`).
+/// The wind scene at sixteen points (as `wind::sample::wind_at`).
 #[inline(always)]
 pub fn wind_lanes(fields: &[RawField], waves: &[RawWave], p: V3, t: f32) -> V3 {
     let mut v = V3::ZERO;

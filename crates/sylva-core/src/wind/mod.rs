@@ -14,7 +14,7 @@
 //!   (Ota 2003), by spectral synthesis: log-spaced waves with amplitudes ∝ f^((1−β)/2),
 //!   advected at `mean_speed` (Taylor's frozen turbulence sets the spatial scale).
 //!
-//! Every field is evaluated through its packed form ([`raw`]) by [`crate::cpu::wind_sample`],
+//! Every field is evaluated through its packed form ([`raw`]) by [`crate::wind::sample`],
 //! the CPU twin of the WGSL kernel, so the friendly API and the GPU share one definition.
 
 pub mod lanes;

@@ -1,4 +1,4 @@
-//! CPU twin of `shader/noise.wgsl`: integer hashing and smooth 1-D value noise, with
+//! CPU twin of `noise.wgsl`: integer hashing and smooth 1-D value noise, with
 //! exactly the same integer operations as the WGSL so both sides hash identically.
 
 /// PCG-style 32-bit hash (O'Neill's PCG output permutation on an LCG step).

@@ -1,5 +1,5 @@
 //! Packed wind fields: one `#[repr(C)]` record per field plus a shared table of waves, the
-//! layout the GPU reads (`shader/wind.wgsl` structs `Field`, `Wave`; a test checks offsets).
+//! layout the GPU reads (`wind.wgsl` structs `Field`, `Wave`; a test checks offsets).
 //!
 //! The meaning of the parameter slots depends on `kind`:
 //!

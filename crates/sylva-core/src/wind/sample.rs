@@ -1,4 +1,4 @@
-//! CPU twin of `shader/wind.wgsl` (`wind_at`) and `shader/wind_sample.wgsl` (the kernel):
+//! CPU twin of `wind.wgsl` (`wind_at`) and `wind_sample.wgsl` (the kernel):
 //! the wind velocity of a packed scene at (x, t). Same operations in the same order as the
 //! WGSL, in f32.
 

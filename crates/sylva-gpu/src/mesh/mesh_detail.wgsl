@@ -1,7 +1,7 @@
 // mesh_detail: one midpoint vertex of a subdivided band per invocation (Akagi §2.3): the
 // midpoint of its edge's two ring vertices (written by mesh_tubes before), the mean normal,
 // and the bark relief sampled at the midpoint less the mean of what the ends carry.
-// CPU twin: sylva_core::cpu::mesh_detail (same bindings, same loop body).
+// CPU twin: sylva_core::mesh::mesh_detail (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> info: MeshInfo;
 @group(0) @binding(1) var<storage, read> detail: array<Detail>;

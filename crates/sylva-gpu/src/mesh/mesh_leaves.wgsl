@@ -1,7 +1,7 @@
 // mesh_leaves: one leaf per invocation (Akagi §2.4): the leaf's transform once, then its
 // polygon — k = 0 the centre, 1.. the rim, two half-circles of the unit n-gon scaled to the
 // blade.
-// CPU twin: sylva_core::cpu::mesh_leaves (same bindings, same loop body).
+// CPU twin: sylva_core::mesh::mesh_leaves (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> info: MeshInfo;
 @group(0) @binding(1) var<storage, read> leaf: array<Leaf>;

@@ -1,7 +1,7 @@
 // mesh_tubes: one ring per invocation (Akagi §2.2–2.3): the Hermite centreline point and
 // the slerped frame once, then the unit polygon placed around it with the interpolated
 // radius and the bark relief along the normal (sides + 1 vertices, the last the seam).
-// CPU twin: sylva_core::cpu::mesh_tubes (same bindings, same loop body).
+// CPU twin: sylva_core::mesh::mesh_tubes (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> info: MeshInfo;
 @group(0) @binding(1) var<storage, read> ring: array<Ring>;

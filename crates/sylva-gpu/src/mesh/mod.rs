@@ -13,8 +13,8 @@ use crate::{GpuContext, GpuError};
 use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::mesh::{MeshFrame, MeshLayout, RawVertex};
-use sylva_core::pose::{SeamPose, pose_buffers};
 use sylva_core::pose::Pose;
+use sylva_core::pose::{SeamPose, pose_buffers};
 use wgpu::util::DeviceExt;
 
 /// One tree's mesh on the GPU: static topology, per-frame vertex buffers.

@@ -1,6 +1,6 @@
 // skin_vertices: linear blend skinning with two bones (Zioma §6.5), one output vertex per
 // invocation, instance-major: out[instance * vertices + v], reading pose first_instance + instance.
-// CPU twin: sylva_core::cpu::skin_vertices (same bindings, same loop body).
+// CPU twin: sylva_core::mesh::skin_vertices (same bindings, same loop body).
 
 struct Skin {
     bone0: u32,

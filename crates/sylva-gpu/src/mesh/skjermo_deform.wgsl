@@ -1,7 +1,7 @@
 // skjermo_deform: Skjermo's deformer (§3), one grid ring per invocation: the unbent branch
 // (eqs. 1-6), the generalised de Casteljau deformation along the stem's current Bézier with
 // Sloan's handles (eqs. 7-9), normals through the Jacobian (eq. 10).
-// CPU twin: sylva_core::cpu::skjermo_deform (same bindings, same loop body).
+// CPU twin: sylva_core::mesh::skjermo_deform (same bindings, same loop body).
 
 struct DeformShape {
     radius: f32,

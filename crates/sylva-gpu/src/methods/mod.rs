@@ -39,13 +39,8 @@ pub enum BuildError {
 
 /// A method's constructor on the GPU: tree, options, the scene's wind on the device and the
 /// placed instances (used by methods that pose every instance; the others ignore them).
-pub type GpuConstructor = fn(
-    &GpuContext,
-    Arc<Tree>,
-    &MethodOptions,
-    &GpuWind,
-    &[Placement],
-) -> Result<Box<dyn GpuAnimator>, BuildError>;
+pub type GpuConstructor =
+    fn(&GpuContext, Arc<Tree>, &MethodOptions, &GpuWind, &[Placement]) -> Result<Box<dyn GpuAnimator>, BuildError>;
 
 /// The buffers of a method that bends Bézier curves, as the deformer reads them (Skjermo
 /// §3): the per-stem constants (`RawSkjermoStem`) and the current curves (`RawStemCurve`).
@@ -65,8 +60,8 @@ pub trait GpuAnimator: Debug + Send + Sync {
     fn tree(&self) -> &Arc<Tree>;
     /// Binds the scene's wind from now on; the state is kept.
     fn set_wind(&mut self, wind: &GpuWind);
-    /// Returns to the rest state at time 0.
-    fn reset(&mut self, ctx: &GpuContext);
+    /// Returns to the rest state at `time`.
+    fn reset(&mut self, ctx: &GpuContext, time: f32);
     /// Advances `steps` steps of `dt` seconds and writes the pose (submitted, not waited
     /// for). Zero steps writes the pose of the current state.
     fn advance(&mut self, ctx: &GpuContext, dt: f32, steps: usize);

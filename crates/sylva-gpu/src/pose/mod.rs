@@ -28,7 +28,7 @@ pub enum FkStrategy {
 
 /// Uploads depth buckets of segment indices, each padded with `u32::MAX` to a multiple of
 /// four entries (storage bindings are at least 16 bytes), with its unpadded length.
-pub(crate) fn upload_buckets(
+pub fn upload_buckets(
     ctx: &GpuContext,
     label: &'static str,
     buckets: &[Vec<u32>],

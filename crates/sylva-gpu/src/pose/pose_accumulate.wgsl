@@ -1,7 +1,7 @@
 // pose_accumulate: acc[i] = delta[root] * ... * delta[parent] * delta[i], by walking the
 // ancestor chain (parents have smaller indices, so the walk takes at most i + 1 steps).
 // Instances: delta and acc hold instance-major copies (instance × segments + segment) of
-// one tree's hierarchy. CPU twin: sylva_core::cpu::pose_fk::pose_accumulate (bindings
+// one tree's hierarchy. CPU twin: sylva_core::pose::fk::pose_accumulate (bindings
 // 0 parents, 1 delta, 2 acc).
 
 @group(0) @binding(0) var<storage, read> parents: array<u32>;

@@ -2,7 +2,7 @@
 // walks of pose_accumulate and pose_positions): for every segment i of this depth,
 // acc[i] = acc[parent] * delta[i] and disp[i] = disp[parent] + (acc[parent] o_i - o_i),
 // o_i = rest[i] - rest[parent]; joints[i] = rest[i] + disp[i], so identity rotations give
-// the rest pose exactly. CPU twin: sylva_core::cpu::pose_fk::pose_level (bindings 0 bucket,
+// the rest pose exactly. CPU twin: sylva_core::pose::fk::pose_level (bindings 0 bucket,
 // 1 parents, 2 rest, 3 delta, 4 acc, 5 disp, 6 joints). Buckets are padded with 0xffffffff
 // to a multiple of four entries.
 

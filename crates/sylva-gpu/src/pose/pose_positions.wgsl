@@ -1,6 +1,6 @@
 // pose_positions: joint[i] = rest[i] + sum over the chain of (acc[parent(a)] o_a - o_a),
 // o_a = rest[a] - rest[parent(a)]: displacements, so identity rotations give the rest pose
-// exactly. Instances: acc and joints instance-major, as in pose_accumulate. CPU twin: sylva_core::cpu::pose_fk::pose_positions (bindings 0 parents, 1 rest,
+// exactly. Instances: acc and joints instance-major, as in pose_accumulate. CPU twin: sylva_core::pose::fk::pose_positions (bindings 0 parents, 1 rest,
 // 2 acc, 3 joints).
 
 @group(0) @binding(0) var<storage, read> parents: array<u32>;

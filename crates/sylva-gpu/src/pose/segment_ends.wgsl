@@ -1,5 +1,5 @@
 // segment_ends: end[i] = start[i] + rotate(orientation[i], (0, length[i], 0)).
-// CPU twin: sylva_core::cpu::segment_ends (same bindings, same loop body).
+// CPU twin: sylva_core::pose::segment_ends (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> segments: array<Segment>;
 @group(0) @binding(1) var<storage, read_write> ends: array<vec4<f32>>;

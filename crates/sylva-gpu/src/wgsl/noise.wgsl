@@ -1,4 +1,4 @@
-// Integer hashing and 1-D value noise shared by kernels. Twin: sylva_core::cpu::noise
+// Integer hashing and 1-D value noise shared by kernels. Twin: sylva_core::wind::noise
 // (same integer operations, so both sides hash identically).
 
 fn pcg_hash(v: u32) -> u32 {

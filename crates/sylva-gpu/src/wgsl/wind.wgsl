@@ -1,5 +1,5 @@
 // Wind fields, shared by every kernel that samples the wind. Twin:
-// sylva_core::cpu::wind_sample::{field_at, wind_at} (same operations, same order).
+// sylva_core::wind::sample::{field_at, wind_at} (same operations, same order).
 // A kernel that composes this file binds the scene at group 0, bindings 0 and 1.
 
 const TAU: f32 = 6.283185307179586;

@@ -5,8 +5,8 @@
 use crate::kernel::{Kernel, KernelTiming, output, read_back, upload};
 use crate::{GpuContext, GpuError};
 use std::sync::Arc;
-use sylva_core::wind::{PackedWind, WindScene};
 use sylva_core::wind::raw::{RawField, RawWave};
+use sylva_core::wind::{PackedWind, WindScene};
 
 /// Uploads a packed wind scene as the (fields, waves) storage buffers that `wind.wgsl` binds
 /// at 0 and 1. An empty scene is bound as one zero constant field (bindings cannot be empty).

@@ -1,5 +1,5 @@
 // wind_sample: velocity of the bound scene at many (x, y, z, t) samples.
-// CPU twin: sylva_core::cpu::wind_sample (bindings 0 fields, 1 waves, 2 samples, 3 out).
+// CPU twin: sylva_core::wind::sample (bindings 0 fields, 1 waves, 2 samples, 3 out).
 
 @group(0) @binding(2) var<storage, read> samples: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> velocities: array<vec4<f32>>;

@@ -1,4 +1,4 @@
-//! CPU twins of `shader/akagi_forces.wgsl`, `akagi_subtree.wgsl` and `akagi_integrate.wgsl`
+//! CPU twins of `akagi_forces.wgsl`, `akagi_subtree.wgsl` and `akagi_integrate.wgsl`
 //! (see [`crate::methods::akagi`]).
 
 use crate::methods::akagi::{RawAkagiSegment, RawAkagiStep};

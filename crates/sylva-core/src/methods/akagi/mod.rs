@@ -1,7 +1,7 @@
 //! Akagi & Kitajima's sway by force propagation (§2.5), with the dynamics a real tool needs.
 //!
 //! Each step:
-//! 1. **Forces** (`cpu::akagi::akagi_forces`): the wind at each segment's current centre
+//! 1. **Forces** (`kernels::akagi_forces`): the wind at each segment's current centre
 //!    pushes on its bark, `½ ρ C_d (2 r̄ L |sin φ|) U² v̂` (φ between the segment and the
 //!    flow: a cylinder's projected area), and on its leaves, `½ ρ C_d A_leaf U² v̂`.
 //! 2. **Propagation** (`akagi_subtree`): each segment's force plus the summed forces of its
@@ -262,6 +262,10 @@ impl Method for Akagi {
 
     fn time(&self, state: &AkagiState) -> f32 {
         state.time
+    }
+
+    fn set_time(&self, state: &mut AkagiState, time: f32) {
+        state.time = time;
     }
 
     fn seam(&self, _tree: &Tree, _wind: &PackedWind, state: &AkagiState, out: &mut SeamPose) {

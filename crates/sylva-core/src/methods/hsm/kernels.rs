@@ -1,4 +1,4 @@
-//! CPU twins of `shader/hsm_clusters.wgsl`, `hsm_goals.wgsl`, `hsm_integrate.wgsl` and
+//! CPU twins of `hsm_clusters.wgsl`, `hsm_goals.wgsl`, `hsm_integrate.wgsl` and
 //! `hsm_pose.wgsl`: Song's four stages (see [`crate::methods::hsm`]). Same operations in the
 //! same order as the WGSL: a cluster's sums go through the GPU's [`LANES`] lanes (lane `j mod
 //! 64` takes slot `j`) and the same halving tree, so both sides add in the same order.

@@ -314,7 +314,7 @@ impl HsmLayout {
         }
         // Each cluster's rate bound k̂: the smallest rate on its path to the root, itself
         // included (clusters come after their parents, so one pass carries it down). Stage 1
-        // lets a cluster's weight pass 1 only up to k̂ h² (see `cpu::hsm::MAX_WEIGHT`).
+        // lets a cluster's weight pass 1 only up to k̂ h² (see `kernels::MAX_WEIGHT`).
         for c in 0..n_clusters {
             let p = parents[c];
             let own = clusters[c].rest_cm[3];

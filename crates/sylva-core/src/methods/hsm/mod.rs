@@ -221,28 +221,6 @@ impl HsmParams {
     }
 }
 
-/// Song's Table 2 (one tree on a GTX 580): clusters, particles, frames per second.
-pub const SONG_TABLE_2: [(usize, usize, f64); 7] = [
-    (5, 300, 2200.0),
-    (15, 900, 1800.0),
-    (67, 3444, 1400.0),
-    (293, 13548, 1000.0),
-    (867, 38772, 670.0),
-    (2230, 99816, 350.0),
-    (4975, 211812, 175.0),
-];
-
-/// Song's Table 3 (ten trees on a GTX 580): clusters, particles, frames per second.
-pub const SONG_TABLE_3: [(usize, usize, f64); 7] = [
-    (50, 3000, 260.0),
-    (150, 9000, 210.0),
-    (670, 34440, 160.0),
-    (2930, 135480, 110.0),
-    (8670, 387720, 70.0),
-    (22300, 998160, 36.0),
-    (49750, 2118120, 17.0),
-];
-
 /// An unusable parameter or a layout beyond its limits.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HsmError {
@@ -535,6 +513,10 @@ impl Method for Hsm {
 
     fn time(&self, state: &HsmState) -> f32 {
         state.time
+    }
+
+    fn set_time(&self, state: &mut HsmState, time: f32) {
+        state.time = time;
     }
 
     fn seam(&self, tree: &Tree, _wind: &PackedWind, state: &HsmState, out: &mut SeamPose) {

@@ -1,5 +1,5 @@
-//! CPU twins of `shader/skjermo_step.wgsl`, `shader/skjermo_rotations.wgsl` and
-//! `shader/skjermo_rest_orient.wgsl` (see [`crate::methods::skjermo`]).
+//! CPU twins of `skjermo_step.wgsl`, `skjermo_rotations.wgsl` and
+//! `skjermo_rest_orient.wgsl` (see [`crate::methods::skjermo`]).
 
 use crate::methods::skjermo::{RawSkjermoState, RawSkjermoStem, RawSkjermoStep, bezier, bezier_d, frame};
 use crate::model::NONE;

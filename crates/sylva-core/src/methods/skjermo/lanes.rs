@@ -1,6 +1,6 @@
 //! Skjermo's step sixteen stems at a time: the fast CPU path.
 //!
-//! `cpu::skjermo::skjermo_step` is the reference (the twin of `skjermo_step.wgsl`, one stem per
+//! `kernels::skjermo_step` is the reference (the twin of `skjermo_step.wgsl`, one stem per
 //! invocation). This module computes the same step on groups of sixteen stems held as
 //! structure-of-arrays lanes ([`crate::simd::F32x16`]). At the larger sizes the step is bound
 //! by memory traffic, so a group keeps only what cannot be recomputed cheaply (100 bytes of
@@ -36,7 +36,7 @@ use rayon::prelude::*;
 use std::ops::{Add, Sub};
 
 /// The attachment frame `[T, N, B]` from a curve tangent and an orientation vector, as
-/// `animate::skjermo::frame`.
+/// `methods::skjermo::frame`.
 #[inline(always)]
 fn frame(tangent: V3, o: V3) -> [V3; 3] {
     let tan = unit_tangent(tangent);
@@ -244,7 +244,7 @@ pub struct LaneStep {
 }
 
 /// One step for every group: re-attach on the parents' previous curves, sample the wind at
-/// the tips, bend P2 and P3 (eqs. 15–17). Same step as `cpu::skjermo::skjermo_step`.
+/// the tips, bend P2 and P3 (eqs. 15–17). Same step as `kernels::skjermo_step`.
 /// `level`: the instruction set to run on, [`crate::simd::level`] for the CPU's best (every
 /// level gives the same bits).
 pub fn step(

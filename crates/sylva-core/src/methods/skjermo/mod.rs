@@ -1,7 +1,7 @@
 //! Skjermo's Bézier bending (§4): every stem is one cubic Bézier whose control points are
 //! re-attached to the parent's curve and bent by the wind each step.
 //!
-//! Each step, for every stem in parallel (`cpu::skjermo::skjermo_step`):
+//! Each step, for every stem in parallel (`kernels::skjermo_step`):
 //! 1. **Re-attach** (§4.2) on the parent's curve *from the previous step*: P0 at the attachment
 //!    parameter, the frame from the curve's derivative there and the parent's orientation
 //!    vector O (the frame `[T, N, B]` with `N` the part of O normal to T — Sloan's handle
@@ -60,21 +60,6 @@ impl Default for SkjermoParams {
         Self { exponent: 1.8, p2_weight: 1.0 / 3.0, max_bend: 0.6, drag: crate::physics::BRANCH_DRAG }
     }
 }
-
-/// Skjermo's results (GeForce 7900 GTX): (branches, updates per second) of the wind
-/// animation shader alone, with 256² textures (65,536 branches) and 512² (262,144).
-pub const SKJERMO_FIGURE: [(usize, f64); 2] = [(65_536, 600.0), (262_144, 180.0)];
-
-/// The benchmark's L-system (`sylva bench skjermo`): a binary tree, every stem one segment,
-/// two children at ±30° (16 iterations: 65,535 stems; 18: 262,143).
-pub const BENCH_BINARY_TREE: &str = "axiom: A(1)\nA(l) -> F(l)[+(30)A(l*0.8)][-(30)/(90)A(l*0.8)]\n";
-
-/// The benchmark's wind, the paper's setting: four sines (eqs. 11–14).
-pub const BENCH_FOUR_SINES: &str = "[[field]]\nkind = \"sum_of_sines\"\nsharpness = 2.0\nwaves = [\n\
-    { amplitude = 4.0, direction_deg = 0.0, wavelength = 40.0, speed = 6.0 },\n\
-    { amplitude = 2.0, direction_deg = 30.0, wavelength = 17.0, speed = 4.0 },\n\
-    { amplitude = 1.0, direction_deg = -25.0, wavelength = 9.0, speed = 3.0 },\n\
-    { amplitude = 0.5, direction_deg = 60.0, wavelength = 5.0, speed = 2.0 },\n]\n";
 
 /// Skjermo's method set up for one tree.
 #[derive(Debug, Clone)]
@@ -244,7 +229,7 @@ impl Skjermo {
         state.steps += 1;
     }
 
-    /// The same step through the reference kernel (`cpu::skjermo::skjermo_step`, the twin of
+    /// The same step through the reference kernel (`kernels::skjermo_step`, the twin of
     /// the WGSL), one stem at a time, on `state.stems` only; kept to check the fast path
     /// against.
     pub fn step_reference(&self, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
@@ -332,6 +317,10 @@ impl Method for Skjermo {
 
     fn time(&self, state: &SkjermoState) -> f32 {
         state.time
+    }
+
+    fn set_time(&self, state: &mut SkjermoState, time: f32) {
+        state.time = time;
     }
 
     fn seam(&self, _tree: &Tree, _wind: &PackedWind, state: &SkjermoState, out: &mut SeamPose) {

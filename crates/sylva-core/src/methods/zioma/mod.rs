@@ -100,16 +100,6 @@ pub fn animator(tree: Arc<Tree>, options: &MethodOptions) -> Result<Box<dyn Anim
     Ok(Simulation::boxed(tree, method))
 }
 
-/// Zioma's Table 6-1 (Intel Xeon 2.33 GHz, GeForce 8800 GTX; 4,617 vertices per
-/// instance): (instances, branches, DirectX 9 ms, DirectX 10 ms, two-bone skinning without
-/// branch simulation ms). The DirectX columns are simulation and skinning per frame.
-pub const ZIOMA_TABLE_6_1: [(usize, usize, f64, f64, f64); 4] = [
-    (30, 2_400, 1.46, 1.34, 0.86),
-    (100, 8_000, 3.90, 3.82, 2.32),
-    (256, 20_480, 9.81, 9.68, 5.82),
-    (1_000, 80_000, 38.21, 37.61, 22.48),
-];
-
 /// A placed copy of a tree (§6.5 instancing); see [`Placement`].
 pub type ZiomaInstance = Placement;
 
@@ -263,6 +253,10 @@ impl Method for Zioma {
 
     fn time(&self, state: &ZiomaState) -> f32 {
         state.time
+    }
+
+    fn set_time(&self, state: &mut ZiomaState, time: f32) {
+        state.time = time;
     }
 
     fn seam(&self, tree: &Tree, wind: &PackedWind, state: &ZiomaState, out: &mut SeamPose) {

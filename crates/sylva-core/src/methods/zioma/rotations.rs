@@ -1,4 +1,4 @@
-//! CPU twin of `shader/zioma_rotations.wgsl`: Zioma's per-segment rotations
+//! CPU twin of `zioma_rotations.wgsl`: Zioma's per-segment rotations
 //! (see [`crate::methods::zioma`]). Bindings: 0 fields, 1 waves, 2 segments, 3 stems,
 //! 4 frames (one per instance), 5 δ (instance-major: `instance × segments + segment`).
 

@@ -1,5 +1,5 @@
 // Shared by Akagi's kernels: per-segment constants and per-step parameters.
-// Twins: sylva_core::animate::akagi::RawAkagiSegment and the (drag, time, dt) arguments.
+// Twins: sylva_core::methods::akagi::RawAkagiSegment and the (drag, time, dt) arguments.
 
 struct AkagiSegment {
     bark_area: f32,

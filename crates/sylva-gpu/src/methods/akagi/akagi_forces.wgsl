@@ -1,5 +1,5 @@
 // akagi_forces: own wind force on each segment at its current centre. CPU twin:
-// sylva_core::cpu::akagi::akagi_forces (bindings 0 fields, 1 waves, 2 segments,
+// sylva_core::methods::akagi::kernels::akagi_forces (bindings 0 fields, 1 waves, 2 segments,
 // 3 akagi segments, 4 joints, 5 acc, 6 step, 7 forces).
 
 @group(0) @binding(2) var<storage, read> segments: array<Segment>;

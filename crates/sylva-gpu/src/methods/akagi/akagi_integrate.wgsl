@@ -1,5 +1,5 @@
 // akagi_integrate: damped angular springs, implicit in stiffness and damping. CPU twin:
-// sylva_core::cpu::akagi::akagi_integrate (bindings 0 segments, 1 akagi segments,
+// sylva_core::methods::akagi::kernels::akagi_integrate (bindings 0 segments, 1 akagi segments,
 // 2 subtree forces, 3 acc, 4 step, 5 theta, 6 omega, 7 delta).
 
 @group(0) @binding(0) var<storage, read> segments: array<Segment>;

@@ -1,6 +1,6 @@
 // akagi_subtree: one depth of the force propagation, deepest first:
 // f_sub[i] = f_own[i] + sum of f_sub over i's children. CPU twin:
-// sylva_core::cpu::akagi::akagi_subtree (bindings 0 bucket, 1 child offsets, 2 child counts,
+// sylva_core::methods::akagi::kernels::akagi_subtree (bindings 0 bucket, 1 child offsets, 2 child counts,
 // 3 child indices, 4 own forces, 5 subtree forces). Buckets are padded with 0xffffffff to
 // a multiple of four entries (storage bindings are at least 16 bytes).
 

@@ -127,12 +127,12 @@ impl GpuAnimator for GpuAkagi {
     fn set_wind(&mut self, wind: &GpuWind) {
         self.wind = wind.clone();
     }
-    fn reset(&mut self, ctx: &GpuContext) {
+    fn reset(&mut self, ctx: &GpuContext, time: f32) {
         let zero = vec![[0.0f32; 4]; self.tree.segments.len()];
         ctx.queue.write_buffer(&self.theta, 0, bytemuck::cast_slice(&zero));
         ctx.queue.write_buffer(&self.omega, 0, bytemuck::cast_slice(&zero));
         self.pose.write_rest(ctx, &self.tree);
-        self.time = 0.0;
+        self.time = time;
     }
     fn advance(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
         for _ in 0..steps {

@@ -1,6 +1,6 @@
 // Shared by the hierarchical shape matching kernels: Song's linearised tree (§5.1) and the
-// rotation extraction. Twins: sylva_core::animate::hsm::Raw* and
-// sylva_core::cpu::hsm::extract_rotation.
+// rotation extraction. Twins: sylva_core::methods::hsm::Raw* and
+// sylva_core::methods::hsm::kernels::extract_rotation.
 
 const HSM_SEGMENT: u32 = 0u;
 const HSM_LEAF: u32 = 1u;
@@ -89,7 +89,7 @@ fn extract_rotation(a: mat3x3<f32>, q0: vec4<f32>, iterations: u32) -> vec4<f32>
 
 // One step: Müller's μ = g / (|tr B| + ε) blended toward Newton's H⁻¹ g, H = tr(B) I − sym(B),
 // B = A Rᵀ, g = Σ rᵢ × aᵢ, by s = s_near · s_pd (near the optimum, H safely positive definite).
-// Twin: rotation_step in sylva_core::cpu::hsm.
+// Twin: rotation_step in sylva_core::methods::hsm::kernels.
 fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, eps: f32) -> vec3<f32> {
     let g = cross(r[0], a[0]) + cross(r[1], a[1]) + cross(r[2], a[2]);
     let tr = dot(r[0], a[0]) + dot(r[1], a[1]) + dot(r[2], a[2]);
@@ -141,7 +141,7 @@ const NEWTON_NEAR: f32 = 0.05;
 const MAX_WEIGHT: f32 = 1e6;
 
 // A cluster's goal for rest offset q, as a displacement from rest: (T q − q) + (c − c⁰).
-// Twin: goal_displacement in sylva_core::cpu::hsm.
+// Twin: goal_displacement in sylva_core::methods::hsm::kernels.
 fn hsm_goal_displacement(st: HsmClusterState, q: vec3<f32>) -> vec3<f32> {
     let tq = st.transform[0].xyz * q.x + st.transform[1].xyz * q.y + st.transform[2].xyz * q.z;
     let shift = vec3<f32>(st.transform[0].w, st.transform[1].w, st.transform[2].w);

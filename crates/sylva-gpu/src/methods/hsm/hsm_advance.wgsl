@@ -2,7 +2,7 @@
 // toward `goal`, gravity (balanced when prestressed), semi-implicit drag toward the owner
 // cluster's wind, damping, then the displacement. The velocity's w is the drag factor;
 // fixed particles (w < 0) stay. Reads the kernel's `owner`, `state`, `step`; writes
-// `displacement`, `velocity`. CPU twin: sylva_core::cpu::hsm (the integration loop shared
+// `displacement`, `velocity`. CPU twin: sylva_core::methods::hsm::kernels (the integration loop shared
 // by both passes).
 
 fn hsm_advance(i: u32, goal: vec4<f32>) {

@@ -1,7 +1,7 @@
 // hsm_clusters (Song §5.2 stage 1): one workgroup per cluster, its particles as
 // invocations; centre of mass and Apq summed in shared memory (each invocation strides over
 // the slots, then a tree reduction), then one invocation extracts R, forms the goal
-// transform, α and the wind. CPU twin: sylva_core::cpu::hsm::hsm_clusters (same lanes, same
+// transform, α and the wind. CPU twin: sylva_core::methods::hsm::kernels::hsm_clusters (same lanes, same
 // reduction tree). Bindings: 0 fields, 1 waves, 2 cluster info, 3 clusters, 4 slots,
 // 5 displacements from rest (w = mass), 6 step, 7 cluster state.
 

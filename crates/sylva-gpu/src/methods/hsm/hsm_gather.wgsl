@@ -2,7 +2,7 @@
 // displacement from rest (xyz) and ᾱ = min(1, Σw) (w), the mean of its clusters' goals
 // weighted by their w = k h² (not clamped at 1, see MAX_WEIGHT), in cluster order. Binds
 // group 0, bindings 0 member offsets, 1 members, 2 cluster state. Twin: particle_goal in
-// sylva_core::cpu::hsm.
+// sylva_core::methods::hsm::kernels.
 
 @group(0) @binding(0) var<storage, read> member_offset: array<u32>;
 @group(0) @binding(1) var<storage, read> member: array<HsmMember>;

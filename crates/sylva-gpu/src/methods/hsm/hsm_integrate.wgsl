@@ -1,6 +1,6 @@
 // hsm_integrate (Song §5.2 stage 4), per particle (`hsm_advance`): shape-matching pull,
 // gravity (balanced when prestressed), semi-implicit drag toward its owner cluster's wind,
-// damping, then the displacement. CPU twin: sylva_core::cpu::hsm::hsm_integrate.
+// damping, then the displacement. CPU twin: sylva_core::methods::hsm::kernels::hsm_integrate.
 // Bindings: 0 owners, 1 cluster state, 2 goals, 3 step, 4 displacements, 5 velocities
 // (w = drag factor, negative when fixed).
 

@@ -1,6 +1,6 @@
 // hsm_particles: stages 3 and 4 in one pass per particle (its goal is read by no other
 // particle, so it skips the goal buffer). The same operations as hsm_goals then
-// hsm_integrate. CPU twin: sylva_core::cpu::hsm::hsm_particles. Bindings: 0 member offsets,
+// hsm_integrate. CPU twin: sylva_core::methods::hsm::kernels::hsm_particles. Bindings: 0 member offsets,
 // 1 members, 2 cluster state (from hsm_gather.wgsl), 3 owners, 4 step, 5 displacements,
 // 6 velocities (w = drag factor, negative when fixed).
 

@@ -1,5 +1,5 @@
 // hsm_pose: the pose seam's accumulated rotation of each segment, its cluster's R (the
-// identity where a truncated layout has no cluster). CPU twin: sylva_core::cpu::hsm::hsm_pose.
+// identity where a truncated layout has no cluster). CPU twin: sylva_core::methods::hsm::kernels::hsm_pose.
 // Bindings: 0 segment clusters, 1 cluster state, 2 acc.
 
 @group(0) @binding(0) var<storage, read> segment_cluster: array<u32>;

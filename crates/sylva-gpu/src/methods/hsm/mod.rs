@@ -273,8 +273,9 @@ impl GpuAnimator for GpuHsm {
     fn set_wind(&mut self, wind: &GpuWind) {
         self.wind = wind.clone();
     }
-    fn reset(&mut self, ctx: &GpuContext) {
+    fn reset(&mut self, ctx: &GpuContext, time: f32) {
         self.write_state(ctx, &self.method.state_at_rest());
+        self.time = time;
         let mut e = ctx.device.create_command_encoder(&Default::default());
         self.record_pose(ctx, &mut e);
         ctx.queue.submit([e.finish()]);

@@ -176,13 +176,13 @@ impl GpuAnimator for GpuSkjermo {
     fn set_wind(&mut self, wind: &GpuWind) {
         self.wind = wind.clone();
     }
-    fn reset(&mut self, ctx: &GpuContext) {
+    fn reset(&mut self, ctx: &GpuContext, time: f32) {
         for s in &self.state {
             ctx.queue.write_buffer(s, 0, bytemuck::cast_slice(&self.rest));
         }
         self.current = 0;
         self.pose.write_rest(ctx, &self.tree);
-        self.time = 0.0;
+        self.time = time;
     }
     fn advance(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
         for _ in 0..steps {

@@ -1,5 +1,5 @@
 // Shared by Skjermo's kernels: structs and Bezier helpers. Twins:
-// sylva_core::animate::skjermo::{RawSkjermoStem, RawSkjermoState, RawSkjermoStep, bezier,
+// sylva_core::methods::skjermo::{RawSkjermoStem, RawSkjermoState, RawSkjermoStep, bezier,
 // bezier_d, frame}.
 
 struct SkjermoStem {

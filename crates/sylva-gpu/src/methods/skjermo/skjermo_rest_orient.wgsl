@@ -2,7 +2,7 @@
 // its rest attachment frame on its parent's rest curve, turned by the parent's orientation
 // (a trunk's from +X at its base). Run once per stem depth (ping-pong), it gives the rest
 // orientations as this device rounds them, so that a step in still air reproduces the rest
-// bit for bit. CPU twin: sylva_core::cpu::skjermo::skjermo_rest_orient (bindings 0 stems,
+// bit for bit. CPU twin: sylva_core::methods::skjermo::kernels::skjermo_rest_orient (bindings 0 stems,
 // 1 orientations in, 2 orientations out).
 
 @group(0) @binding(0) var<storage, read> stems: array<SkjermoStem>;

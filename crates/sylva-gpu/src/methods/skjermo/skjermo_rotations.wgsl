@@ -1,6 +1,6 @@
 // skjermo_rotations: seam rotations delta_i = R_parent^-1 R_i, R the rotation of a stem's
 // tangent (rest -> current) at the segment's middle. CPU twin:
-// sylva_core::cpu::skjermo::skjermo_rotations (bindings 0 segment params, 1 stems,
+// sylva_core::methods::skjermo::kernels::skjermo_rotations (bindings 0 segment params, 1 stems,
 // 2 state, 3 parents, 4 delta).
 
 @group(0) @binding(0) var<storage, read> params: array<vec4<f32>>;

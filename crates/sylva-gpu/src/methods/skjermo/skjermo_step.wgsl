@@ -1,5 +1,5 @@
 // skjermo_step: re-attach every stem on its parent's previous curve and bend P2, P3
-// (eqs. 15-17). CPU twin: sylva_core::cpu::skjermo::skjermo_step (bindings 0 fields,
+// (eqs. 15-17). CPU twin: sylva_core::methods::skjermo::kernels::skjermo_step (bindings 0 fields,
 // 1 waves, 2 stems, 3 previous state, 4 step, 5 next state).
 
 @group(0) @binding(2) var<storage, read> stems: array<SkjermoStem>;

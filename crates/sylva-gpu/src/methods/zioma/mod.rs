@@ -128,8 +128,8 @@ impl GpuAnimator for GpuZioma {
     fn set_wind(&mut self, wind: &GpuWind) {
         self.wind = wind.clone();
     }
-    fn reset(&mut self, _ctx: &GpuContext) {
-        self.time = 0.0;
+    fn reset(&mut self, _ctx: &GpuContext, time: f32) {
+        self.time = time;
     }
     fn advance(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
         // Time accumulates step by step, as on the CPU.

@@ -1,5 +1,5 @@
 // trunk_noise: Zioma's trunk noise bands, (parallel, perpendicular, twist) at many
-// (t, tree seed) samples. CPU twin: sylva_core::cpu::trunk_noise (bindings 0 bands,
+// (t, tree seed) samples. CPU twin: sylva_core::methods::zioma::trunk (bindings 0 bands,
 // 1 samples, 2 angles).
 
 struct Band {

@@ -1,5 +1,5 @@
 // zioma_rotations: Zioma's per-segment rotations. CPU twin:
-// sylva_core::cpu::zioma_rotations (bindings 0 fields, 1 waves — from wind.wgsl —
+// sylva_core::methods::zioma::rotations (bindings 0 fields, 1 waves — from wind.wgsl —
 // 2 segments, 3 stems, 4 frames (one per instance), 5 delta, instance-major).
 
 struct ZiomaStem {

@@ -11,7 +11,7 @@ use sylva_core::species::SpeciesSource;
 use sylva_core::{Grammar, LSystemOptions};
 
 /// A binary tree of 2^20 − 1 = 1,048,575 segments after 20 steps (Skjermo's benchmark tree).
-use sylva_core::methods::skjermo::BENCH_BINARY_TREE as MILLION;
+use sylva_bench::tables::BENCH_BINARY_TREE as MILLION;
 
 fn one_core<T: Send>(f: impl FnOnce() -> T + Send) -> T {
     rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(f)

@@ -4,8 +4,9 @@
 //! For profiling the lane kernel alone, without the reference kernel the CLI bench also times.
 
 use std::time::Instant;
+use sylva_bench::tables::{BENCH_BINARY_TREE, BENCH_FOUR_SINES};
 use sylva_core::methods::Method;
-use sylva_core::methods::skjermo::{BENCH_BINARY_TREE, BENCH_FOUR_SINES, Skjermo, SkjermoParams};
+use sylva_core::methods::skjermo::{Skjermo, SkjermoParams};
 use sylva_core::wind::WindScene;
 use sylva_core::{Grammar, LSystemOptions};
 

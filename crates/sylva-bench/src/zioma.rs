@@ -12,18 +12,21 @@
 //! - **skinning only**: skinning from a fixed pose, the paper's "two-bone skinning without
 //!   branch simulation" column.
 
-use crate::bench_akagi::{Report, cell};
-use crate::bench_cmd::{Env, Series, markdown_head, measure, measure_gpu, plot_series, write_atomic};
+use crate::akagi::{Report, cell};
+use crate::harness::{Env, markdown_head, measure, measure_gpu, write_atomic};
+use crate::plot::{Series, plot_series};
+use crate::tables::ZIOMA_TABLE_6_1;
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 use serde::Serialize;
 use std::path::PathBuf;
 use sylva_core::mesh::{MeshLayout, MeshParams, RawVertex, SkinLayout};
-use sylva_core::methods::zioma::{ZIOMA_TABLE_6_1, Zioma, ZiomaInstance, ZiomaParams};
+use sylva_core::methods::zioma::{Zioma, ZiomaInstance, ZiomaParams};
 use sylva_core::pose::{Pose, seam_buffers};
 use sylva_core::wind::WindScene;
 use sylva_core::{Grammar, LSystemOptions, Tree};
+use sylva_gpu::methods::GpuAnimator;
 
 /// The 80-branch tree: a trunk of 80 segments and 79 side branches of four segments.
 pub const EIGHTY_BRANCHES: &str =
@@ -140,14 +143,20 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         let mut gpu_skin_skipped = None;
         let (gpu_pose, gpu_frame, gpu_skin) = match env.ctx {
             Some(c) => {
-                let g = sylva_gpu::pose::GpuZioma::with_instances(c, &tree, &z, &wind, &placed)?;
+                let mut g = sylva_gpu::methods::zioma::GpuZioma::with_instances(
+                    c,
+                    std::sync::Arc::new(tree.clone()),
+                    z.clone(),
+                    &sylva_gpu::wind::GpuWind::from_scene(c, &wind)?,
+                    &placed,
+                )?;
                 let pose = measure_gpu(env.budget, c, |n| {
                     for _ in 0..n {
-                        g.submit(c, &tree, &z, tick());
+                        g.submit(c, tick());
                     }
                     Ok(())
                 })?;
-                let gs = match sylva_gpu::skin::GpuSkin::new(c, &layout, &skin, instances as u32) {
+                let gs = match sylva_gpu::mesh::skin::GpuSkin::new(c, &layout, &skin, instances as u32) {
                     Ok(gs) => Some(gs),
                     Err(e @ sylva_gpu::GpuError::TooLarge { .. }) => {
                         bar.suspend(|| println!("{instances} instances: no GPU skinning: {e}"));
@@ -160,9 +169,9 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                     Some(gs) => {
                         let frame = measure_gpu(env.budget, c, |n| {
                             for _ in 0..n {
-                                g.submit(c, &tree, &z, tick());
+                                g.submit(c, tick());
                                 let mut e = c.device.create_command_encoder(&Default::default());
-                                gs.record(c, &mut e, g.gpu_pose().joints_buffer(), g.gpu_pose().acc_buffer());
+                                gs.record(c, &mut e, g.pose_buffers().joints_buffer(), g.pose_buffers().acc_buffer());
                                 c.queue.submit([e.finish()]);
                             }
                             Ok(())

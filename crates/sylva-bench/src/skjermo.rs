@@ -10,19 +10,18 @@
 //! `skjermo.wgsl`, one dispatch per update. `--quick` times 4,095 and 16,383 branches
 //! instead (no paper figure).
 
-use crate::bench_akagi::Report;
-use crate::bench_cmd::{
-    Env, Rate, Series, markdown_head, measure, measure_gpu, plot_series, rate_cell as rate, write_atomic,
-};
+use crate::akagi::Report;
+use crate::harness::{Env, Rate, markdown_head, measure, measure_gpu, rate_cell as rate, write_atomic};
+use crate::plot::{Series, plot_series};
+use crate::tables::{BENCH_BINARY_TREE, BENCH_FOUR_SINES, SKJERMO_FIGURE};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 use serde::Serialize;
 use std::path::PathBuf;
+use sylva_core::methods::Method;
 use sylva_core::methods::skjermo::lanes::{StateLanes, StemLanes};
-use sylva_core::methods::skjermo::{
-    BENCH_BINARY_TREE, BENCH_FOUR_SINES, RawSkjermoState, RawSkjermoStem, SKJERMO_FIGURE, Skjermo, SkjermoParams,
-};
+use sylva_core::methods::skjermo::{RawSkjermoState, RawSkjermoStem, Skjermo, SkjermoParams};
 use sylva_core::wind::WindScene;
 use sylva_core::{Grammar, LSystemOptions};
 
@@ -97,7 +96,12 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         };
         let gpu = match env.ctx {
             Some(c) => {
-                let mut g = sylva_gpu::pose::GpuSkjermo::new(c, &tree, &m, &wind)?;
+                let mut g = sylva_gpu::methods::skjermo::GpuSkjermo::new(
+                    c,
+                    std::sync::Arc::new(tree.clone()),
+                    &m,
+                    &sylva_gpu::wind::GpuWind::from_scene(c, &wind)?,
+                )?;
                 Some(measure_gpu(env.budget, c, |k| {
                     for _ in 0..k {
                         g.step_only(c, dt);

@@ -9,14 +9,16 @@
 //! per submission, wall clock to completion. The paper's figures include drawing (about
 //! 0.1 % of its CPU time); ours time generation only.
 
-use crate::bench_cmd::{Env, Machine, Series, markdown_head, measure, measure_gpu, plot_series, write_atomic};
+use crate::harness::{Env, Machine, markdown_head, measure, measure_gpu, write_atomic};
+use crate::plot::{Series, plot_series};
+use crate::tables::AKAGI_TABLE_2;
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 use serde::Serialize;
 use std::path::PathBuf;
 use sylva_core::Tree;
-use sylva_core::mesh::{AKAGI_TABLE_2, MeshLayout, MeshParams};
+use sylva_core::mesh::{MeshLayout, MeshParams};
 use sylva_core::methods::zioma::{Zioma, ZiomaParams};
 use sylva_core::pose::seam_buffers;
 use sylva_core::species::SpeciesSource;

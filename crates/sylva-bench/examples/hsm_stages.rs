@@ -10,7 +10,6 @@
 //! Song's sizes.
 
 use std::time::Instant;
-use sylva_core::methods::Method;
 use sylva_core::methods::hsm::kernels::*;
 use sylva_core::methods::hsm::*;
 use sylva_core::species::SpeciesSource;

@@ -1,0 +1,223 @@
+//! Timing and the record of the machine: wall-clock and timestamp-query sampling, median
+//! and spread, and the CPU's and GPU's copy bandwidth every row is set against.
+
+use anyhow::Result;
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+/// A timing: median and spread of the samples, in steps per second.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Rate {
+    /// Median of the samples, steps/s.
+    pub median: f64,
+    /// Slowest sample, steps/s.
+    pub min: f64,
+    /// Fastest sample, steps/s.
+    pub max: f64,
+    /// Samples taken.
+    pub samples: usize,
+    /// Steps per sample.
+    pub steps_per_sample: usize,
+    /// How the samples were timed: `wall clock` or `timestamp queries`.
+    pub clock: &'static str,
+}
+
+impl Rate {
+    /// Milliseconds per step: [median, fastest, slowest].
+    pub fn ms(&self) -> [f64; 3] {
+        [1e3 / self.median, 1e3 / self.max, 1e3 / self.min]
+    }
+}
+
+/// The machine a bench ran on.
+#[derive(Debug, Clone, Serialize)]
+pub struct Machine {
+    /// CPU model name.
+    pub cpu: String,
+    /// Hardware threads available.
+    pub cores: usize,
+    /// rayon worker threads.
+    pub threads: usize,
+    /// GPU adapter, backend and driver (when the GPU was timed).
+    pub gpu: Option<String>,
+    /// Measured CPU copy bandwidth (read + write), bytes/s.
+    pub cpu_bandwidth: f64,
+    /// Measured GPU buffer-copy bandwidth (read + write), bytes/s.
+    pub gpu_bandwidth: Option<f64>,
+    /// How GPU work is timed: `timestamp queries` or `wall clock`.
+    pub gpu_clock: Option<&'static str>,
+    /// UTC time of the run.
+    pub date: String,
+    /// The command line.
+    pub command: String,
+}
+
+/// What every table's runner needs.
+#[derive(Debug)]
+pub struct Env<'a> {
+    /// Small sizes only.
+    pub quick: bool,
+    /// Time budget per measurement, s.
+    pub budget: f64,
+    /// Whether to time the CPU.
+    pub time_cpu: bool,
+    /// The GPU, when it is timed.
+    pub ctx: Option<&'static sylva_gpu::GpuContext>,
+    /// Where the files go.
+    pub out_dir: &'a Path,
+    /// The machine record.
+    pub machine: &'a Machine,
+}
+
+/// Times `f(n)` (n steps) by wall clock: one warm-up call, a step count that makes a sample
+/// about a fifth of `budget`, then samples until the budget is spent (at least 3, at most
+/// 15).
+pub fn measure(budget: f64, mut f: impl FnMut(usize) -> Result<()>) -> Result<Rate> {
+    sample(budget, |n| {
+        let t0 = Instant::now();
+        f(n)?;
+        Ok((t0.elapsed().as_secs_f64(), false))
+    })
+}
+
+/// Times GPU work as [`measure`] does; `f(n)` submits n steps (it need not wait). With
+/// timestamp queries a sample is the GPU's time from the first submission to the end of the
+/// last; without them, wall clock from the first submission to completion.
+pub fn measure_gpu(budget: f64, ctx: &sylva_gpu::GpuContext, mut f: impl FnMut(usize) -> Result<()>) -> Result<Rate> {
+    let timer = sylva_gpu::timer::GpuTimer::new(ctx);
+    sample(budget, |n| {
+        ctx.wait()?;
+        let t0 = Instant::now();
+        if let Some(t) = &timer {
+            t.start(ctx);
+        }
+        f(n)?;
+        let stamped = match &timer {
+            Some(t) => {
+                t.stop(ctx);
+                t.read(ctx)?
+            }
+            None => None,
+        };
+        ctx.wait()?;
+        Ok(match stamped {
+            Some(d) => (d.as_secs_f64(), true),
+            None => (t0.elapsed().as_secs_f64(), false),
+        })
+    })
+}
+
+/// The sampling loop: `f(n)` runs n steps and returns (seconds, timed by timestamps).
+fn sample(budget: f64, mut f: impl FnMut(usize) -> Result<(f64, bool)>) -> Result<Rate> {
+    let one = f(1)?.0.max(1e-7);
+    // A second probe with more steps, now that caches and pipelines are warm.
+    let probe = ((budget / 20.0 / one) as usize).clamp(1, 100_000);
+    let per = (f(probe)?.0 / probe as f64).max(1e-8);
+    let n = ((budget / 5.0 / per) as usize).clamp(1, 1_000_000);
+    let mut rates = Vec::new();
+    let mut stamped = true;
+    let start = Instant::now();
+    while rates.len() < 3 || (start.elapsed().as_secs_f64() < budget && rates.len() < 15) {
+        let (secs, s) = f(n)?;
+        stamped &= s;
+        rates.push(n as f64 / secs.max(1e-9));
+    }
+    rates.sort_by(f64::total_cmp);
+    Ok(Rate {
+        median: rates[rates.len() / 2],
+        min: rates[0],
+        max: rates[rates.len() - 1],
+        samples: rates.len(),
+        steps_per_sample: n,
+        clock: if stamped { "timestamp queries" } else { "wall clock" },
+    })
+}
+
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}
+
+/// Parallel copy of 64 MiB (best of 5): bytes read plus bytes written per second.
+pub fn cpu_bandwidth() -> f64 {
+    use rayon::prelude::*;
+    let n = 16 << 20;
+    let src = vec![1.0f32; n];
+    let mut dst = vec![0.0f32; n];
+    let mut best = f64::INFINITY;
+    for _ in 0..5 {
+        let t0 = Instant::now();
+        dst.par_chunks_mut(1 << 16).zip(src.par_chunks(1 << 16)).for_each(|(d, s)| d.copy_from_slice(s));
+        best = best.min(t0.elapsed().as_secs_f64());
+    }
+    std::hint::black_box(&dst);
+    2.0 * (n * 4) as f64 / best.max(1e-9)
+}
+
+/// Buffer-to-buffer copy of 64 MiB on the GPU (best of 5): bytes read plus written per second.
+pub fn gpu_bandwidth(ctx: &sylva_gpu::GpuContext) -> Result<f64> {
+    let bytes = 64u64 << 20;
+    let make = |label| {
+        ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes,
+            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    };
+    let (a, b) = (make("bandwidth a"), make("bandwidth b"));
+    let mut best = f64::INFINITY;
+    for _ in 0..6 {
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        e.copy_buffer_to_buffer(&a, 0, &b, 0, bytes);
+        ctx.wait()?;
+        let t0 = Instant::now();
+        ctx.queue.submit([e.finish()]);
+        ctx.wait()?;
+        best = best.min(t0.elapsed().as_secs_f64());
+    }
+    Ok(2.0 * bytes as f64 / best.max(1e-9))
+}
+
+pub fn rate_cell(r: Option<Rate>) -> String {
+    r.map_or("–".into(), |r| format!("{:.0} ({:.0}–{:.0})", r.median, r.min, r.max))
+}
+
+pub fn ratio_cell(r: Option<Rate>, paper: f64) -> String {
+    r.map_or("–".into(), |r| format!("{:.2}", r.median / paper))
+}
+
+pub fn frac_cell(f: Option<f64>) -> String {
+    f.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f))
+}
+
+/// The heading and machine paragraph every table's Markdown starts with.
+pub fn markdown_head(title: &str, table: &str, m: &Machine) -> String {
+    let mut s = format!("### {title} ({table})\n\n");
+    s += &format!(
+        "Machine: {} ({} threads of {} cores), CPU copy bandwidth {:.1} GB/s",
+        m.cpu,
+        m.threads,
+        m.cores,
+        m.cpu_bandwidth / 1e9
+    );
+    if let (Some(g), Some(b)) = (&m.gpu, m.gpu_bandwidth) {
+        s +=
+            &format!("; GPU {g}, copy bandwidth {:.1} GB/s, timed by {}", b / 1e9, m.gpu_clock.unwrap_or("wall clock"));
+    }
+    s += &format!(".\nDate {}. Command `{}`.\n\n", m.date, m.command);
+    s
+}
+
+/// Writes `bytes` to `path` completely or not at all.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    sylva_core::io::write_atomic(path, |w| w.write_all(bytes))
+        .map_err(|e| anyhow::anyhow!("writing {}: {e}", path.display()))
+}
