@@ -19,24 +19,25 @@ fn two_waves(sharpness: Option<f32>) -> WindScene {
     }))
 }
 
-/// Skjermo eq. 13 at (x, z) = (1, 2), t = 0.5, by hand:
+/// Skjermo eq. 13 at (x, z) = (1, 2), t = 0.5, by hand, with the phase travelling downwind
+/// (`θ = D·x w − t φ`):
 /// wave 1: D = (cos 30°, sin 30°) = (0.866025, 0.5), w = 2π/10 = 0.628319, φ = 3w = 1.884956,
-///   θ₁ = (0.866025·1 + 0.5·2)·0.628319 + 0.5·1.884956 = 2.114936, sin θ₁ = 0.855573;
+///   θ₁ = (0.866025·1 + 0.5·2)·0.628319 − 0.5·1.884956 = 0.229981, sin θ₁ = 0.227959;
 /// wave 2: D = (−0.5, 0.866025), w = 2π/25 = 0.251327, φ = 5w = 1.256637,
-///   θ₂ = (−0.5 + 1.732051)·0.251327 + 0.5·1.256637 = 0.937967, sin θ₂ = 0.806357;
-/// F = D₁·2·0.855573 + D₂·1·0.806357 = (1.078717, 0, 1.553899).
+///   θ₂ = (−0.5 + 1.732051)·0.251327 − 0.5·1.256637 = −0.318670, sin θ₂ = −0.313304;
+/// F = D₁·2·0.227959 + D₂·1·(−0.313304) = (0.551488, 0, −0.043371).
 #[test]
 fn sum_of_sines_reproduces_eq_13() {
     let v = two_waves(None).sample(Vec3::new(1.0, 7.0, 2.0), 0.5);
-    assert!((v - Vec3::new(1.078717, 0.0, 1.553899)).length() < 2e-5, "{v}");
+    assert!((v - Vec3::new(0.551488, 0.0, -0.043371)).length() < 2e-5, "{v}");
 }
 
 /// Eq. 14 with k = 2 at the same point: F = Σ Dᵢ Aᵢ ((sin θᵢ + 1)/2)²
-/// = D₁·2·0.927787² + D₂·1·0.903179² = (1.083062, 0, 1.567232).
+/// = D₁·2·0.613979² + D₂·1·0.343348² = (0.593988, 0, 0.479064).
 #[test]
 fn sum_of_sines_reproduces_eq_14() {
     let v = two_waves(Some(2.0)).sample(Vec3::new(1.0, 0.0, 2.0), 0.5);
-    assert!((v - Vec3::new(1.083062, 0.0, 1.567232)).length() < 2e-5, "{v}");
+    assert!((v - Vec3::new(0.593988, 0.0, 0.479064)).length() < 2e-5, "{v}");
 }
 
 #[test]
@@ -163,19 +164,9 @@ fn blast_expands_outward_and_decays() {
 }
 
 /// Log-log slope of the temporal power spectrum of turbulence at one point, by FFT of a
-/// long series and a least-squares fit over log-spaced bins inside [f_min, f_max].
-fn spectral_slope(beta: f32) -> f64 {
+/// long series and a least-squares fit over log-spaced bins inside [lo, hi] Hz.
+fn spectral_slope_of(turb: Turbulence, lo: f64, hi: f64) -> f64 {
     use rustfft::{FftPlanner, num_complex::Complex};
-    let turb = Turbulence {
-        intensity: 2.0,
-        beta,
-        f_min: 0.005,
-        f_max: 5.0,
-        components: 512,
-        mean_speed: 5.0,
-        vertical: 0.3,
-        seed: 3,
-    };
     let (fields, waves) = one(WindField::Turbulence(turb)).pack();
     let n = 1 << 17;
     let dt = 0.04f64;
@@ -187,8 +178,8 @@ fn spectral_slope(beta: f32) -> f64 {
         .collect();
     FftPlanner::new().plan_fft_forward(n).process(&mut buf);
     let df = 1.0 / (n as f64 * dt);
-    // Bins of 0.1 decade from 0.02 to 3 Hz.
-    let (lo, hi) = (0.02f64.log10(), 3.0f64.log10());
+    // Bins of 0.1 decade.
+    let (lo, hi) = (lo.log10(), hi.log10());
     let nb = ((hi - lo) / 0.1).round() as usize;
     let mut pts = Vec::new();
     for b in 0..nb {
@@ -202,6 +193,21 @@ fn spectral_slope(beta: f32) -> f64 {
     let sxx = pts.iter().map(|p| p.0 * p.0).sum::<f64>();
     let sxy = pts.iter().map(|p| p.0 * p.1).sum::<f64>();
     (m * sxy - sx * sy) / (m * sxx - sx * sx)
+}
+
+fn spectral_slope(beta: f32) -> f64 {
+    let turb = Turbulence {
+        intensity: 2.0,
+        beta,
+        f_min: 0.005,
+        f_max: 5.0,
+        components: 512,
+        mean_speed: 5.0,
+        vertical: 0.3,
+        seed: 3,
+        direction_deg: None,
+    };
+    spectral_slope_of(turb, 0.02, 3.0)
 }
 
 #[test]
@@ -224,6 +230,7 @@ fn turbulence_has_the_requested_intensity_and_is_spatially_coherent() {
         mean_speed: 5.0,
         vertical: 0.3,
         seed: 9,
+        direction_deg: None,
     };
     let scene = one(WindField::Turbulence(turb));
     let (f, w) = scene.pack();
@@ -258,9 +265,18 @@ fn scenes_round_trip_through_toml() {
     let path = dir.path().join("w.toml");
     scene.save(&path).unwrap();
     assert_eq!(WindScene::load(&path).unwrap(), scene);
-    // Sampling is the sum of the fields.
+    // Sampling is the sum of the fields, once each turbulence field is told the direction
+    // the whole scene carries it (alone, a field has no mean wind to follow).
     let p = Vec3::new(3.0, 4.0, 5.0);
-    let sum: Vec3 = scene.fields.iter().map(|f| one(f.clone()).sample(p, 12.0)).sum();
+    let mean = scene.mean_direction();
+    let pinned = |f: &WindField| match f {
+        WindField::Turbulence(t) => {
+            WindField::Turbulence(Turbulence { direction_deg: Some(mean.z.atan2(mean.x).to_degrees()), ..t.clone() })
+        }
+        other => other.clone(),
+    };
+    assert!(scene.fields.iter().any(|f| matches!(f, WindField::Turbulence(_))));
+    let sum: Vec3 = scene.fields.iter().map(|f| one(pinned(f)).sample(p, 12.0)).sum();
     assert!((scene.sample(p, 12.0) - sum).length() < 1e-4);
 }
 
@@ -318,4 +334,51 @@ fn trunk_noise_follows_size_and_stiffness() {
     let sd = |k: usize| (sq[k] - mean[k] * mean[k]).sqrt();
     assert!(sd(0) > sd(1) && sd(1) > sd(2), "{} {} {}", sd(0), sd(1), sd(2));
     assert_ne!(slender.angles(10.0, 1), slender.angles(10.0, 2));
+}
+
+/// Gusts travel downwind (frozen turbulence and the sum of sines' waves carried with the
+/// mean wind): in the `gusty` preset, the speed 12 m downwind of a point follows the speed
+/// there, about 12 m / 6 m/s = 2 s later; the cross-correlation peaks at a positive lag.
+#[test]
+fn gusty_wind_gusts_travel_downwind_from_probe_to_probe() {
+    let scene = WindScene::resolve("gusty").unwrap();
+    let wind = scene.packed();
+    let d = scene.mean_direction();
+    let (up, down) = (Vec3::new(0.0, 8.0, 0.0), Vec3::new(0.0, 8.0, 0.0) + d * 12.0);
+    // Before the gust front (t = 5 s) and the vortex (t = 8 s) arrive; then after them.
+    let dt = 0.05f32;
+    let series = |p: Vec3| -> Vec<f64> {
+        (0..6000).map(|i| wind.at(p, 100.0 + i as f32 * dt).dot(d) as f64).collect::<Vec<_>>()
+    };
+    let (a, b) = (series(up), series(down));
+    let mean = |x: &[f64]| x.iter().sum::<f64>() / x.len() as f64;
+    let (ma, mb) = (mean(&a), mean(&b));
+    let corr = |lag: i64| {
+        let mut s = 0.0;
+        for i in 0..a.len() as i64 {
+            let j = i + lag;
+            if j >= 0 && (j as usize) < b.len() {
+                s += (a[i as usize] - ma) * (b[j as usize] - mb);
+            }
+        }
+        s
+    };
+    let best = (-120..=120).max_by(|&x, &y| corr(x).total_cmp(&corr(y))).unwrap();
+    let lag_s = best as f32 * dt;
+    println!("downwind probe lags the upwind one by {lag_s:.2} s");
+    assert!(lag_s > 0.5, "the downwind probe leads by {:.2} s: gusts travel upwind", -lag_s);
+    assert!((lag_s - 2.0).abs() < 1.0, "lag {lag_s:.2} s, expected about 2 s (12 m at 6 m/s)");
+}
+
+/// The `gusty` preset's turbulence (64 waves) has the spectrum it asks for, β = 5/3 within
+/// ±0.1.
+#[test]
+fn gusty_turbulence_has_the_configured_spectral_slope() {
+    let scene = WindScene::resolve("gusty").unwrap();
+    let Some(WindField::Turbulence(t)) = scene.fields.iter().find(|f| matches!(f, WindField::Turbulence(_))) else {
+        panic!("gusty has turbulence");
+    };
+    let slope = spectral_slope_of(t.clone(), 0.03, 3.0);
+    println!("gusty turbulence: fitted slope {slope:.3}, configured −{:.3}", t.beta);
+    assert!((slope + t.beta as f64).abs() < 0.1, "slope {slope}, β {}", t.beta);
 }

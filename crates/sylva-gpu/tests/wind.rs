@@ -86,6 +86,7 @@ fn scenes(rng: &mut rand::rngs::StdRng) -> Vec<(&'static str, WindScene, f32, f3
         mean_speed: r(2.0, 12.0),
         vertical: 0.3,
         seed: 7,
+        direction_deg: None,
     };
     let peak_t: f32 = turb.waves().iter().map(|w| Vec3::from_slice(&w.dir[..3]).length()).sum();
     let one = |f: WindField| WindScene { fields: vec![f] };

@@ -49,8 +49,8 @@ pub struct SineWave {
     pub direction_deg: f32,
     /// Wavelength, m (w = 2π / wavelength).
     pub wavelength: f32,
-    /// Speed, m/s (φ = speed · w). As printed in eq. 11, the phase `D·x w + t φ` travels
-    /// toward −D.
+    /// Speed, m/s (φ = speed · w). The phase is `D·x w − t φ`, so the wave travels toward
+    /// +D, downwind (eq. 11 as printed, `D·x w + t φ`, carries its gusts upwind).
     pub speed: f32,
 }
 
@@ -158,9 +158,13 @@ pub struct Turbulence {
     #[serde(default = "components")]
     pub components: u32,
     /// Speed that carries the eddies, m/s: a wave of frequency f has wavelength
-    /// `mean_speed / f`.
+    /// `mean_speed / f` along the wind (Taylor's frozen turbulence).
     #[serde(default = "mean_speed")]
     pub mean_speed: f32,
+    /// Direction the eddies travel, degrees from +X toward +Z. Absent: the scene's mean
+    /// wind (the sum of its constant fields; +X in a scene without one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction_deg: Option<f32>,
     /// Vertical rms as a fraction of the horizontal.
     #[serde(default = "vertical")]
     pub vertical: f32,
@@ -400,6 +404,9 @@ impl WindScene {
                         ("mean_speed", t.mean_speed, 1e-2, 1e3),
                         ("vertical", t.vertical, 0.0, 10.0),
                     ]);
+                    if let Some(d) = t.direction_deg {
+                        vals.push(("direction_deg", d, -1e4, 1e4));
+                    }
                     if t.f_max <= t.f_min {
                         return Err((i, "f_max", format!("{} must be above f_min ({})", t.f_max, t.f_min)));
                     }
@@ -446,7 +453,7 @@ impl WindScene {
                         let wn = std::f32::consts::TAU / w.wavelength;
                         waves.push(RawWave {
                             dir: [dx * w.amplitude, 0.0, dz * w.amplitude, 0.0],
-                            k: [dx * wn, 0.0, dz * wn, w.speed * wn],
+                            k: [dx * wn, 0.0, dz * wn, -w.speed * wn],
                             phase: [0.0; 4],
                         });
                     }
@@ -472,13 +479,27 @@ impl WindScene {
                 }
                 WindField::Turbulence(t) => {
                     r.kind = kind::TURBULENCE;
-                    waves.extend(t.waves());
+                    waves.extend(t.waves_along(self.mean_direction()));
                 }
             }
             r.wave_count = waves.len() as u32 - r.wave_offset;
             fields.push(r);
         }
         (fields, waves)
+    }
+
+    /// The horizontal unit direction of the scene's mean wind: the sum of its constant
+    /// fields (+X when they cancel or there are none).
+    pub fn mean_direction(&self) -> Vec3 {
+        let sum: Vec3 = self
+            .fields
+            .iter()
+            .filter_map(|f| match f {
+                WindField::Constant(c) => Some(Vec3::from_array(c.direction).normalize_or_zero() * c.speed),
+                _ => None,
+            })
+            .sum();
+        Vec3::new(sum.x, 0.0, sum.z).try_normalize().unwrap_or(Vec3::X)
     }
 
     /// [`Self::pack`] as one value.
@@ -496,30 +517,59 @@ impl WindScene {
 }
 
 impl Turbulence {
-    /// The waves of the spectral synthesis: frequencies log-spaced (jittered) over
-    /// [f_min, f_max]; amplitude² ∝ f^(1−β) (waves per unit frequency thin out as 1/f, so
-    /// the power spectral density goes as f^(−β)); normalised so each horizontal component
-    /// has rms `intensity`; random phase; velocity direction random, mostly horizontal;
-    /// wave vector horizontal, random direction, |k| = 2π f / mean_speed.
+    /// The waves of the spectral synthesis, travelling along the +X axis unless
+    /// `direction_deg` says otherwise (see [`Self::waves_along`]).
     pub fn waves(&self) -> Vec<RawWave> {
+        self.waves_along(Vec3::X)
+    }
+
+    /// The waves of the spectral synthesis, frozen turbulence carried along `mean` (a
+    /// horizontal direction, used when `direction_deg` is absent). Frequencies: one per
+    /// log-uniform band of [f_min, f_max], jittered inside it; a wave's power is the
+    /// integral of f^(−β) over its band, so the sum has the 1/f^β spectrum whatever the
+    /// number of waves; normalised so each horizontal component has rms `intensity`. Random
+    /// phase and velocity direction (mostly horizontal). Wave vector `k = (2π f / U) û + k⊥`
+    /// with û the travel direction and a lateral part |k⊥| ≤ 2π f / U: every wave's phase
+    /// `2π f t − k·x` is constant along `x = x₀ + U û t`, so the whole pattern moves
+    /// downwind at `mean_speed` (Taylor's hypothesis) while points across the wind decorrelate.
+    pub fn waves_along(&self, mean: Vec3) -> Vec<RawWave> {
         let n = self.components as usize;
         let mut rng = Stream::new(mix64(self.seed ^ 0x7475_7262));
+        let along = match self.direction_deg {
+            Some(deg) => {
+                let (c, s) = horizontal(deg);
+                glam::DVec3::new(c as f64, 0.0, s as f64)
+            }
+            None => glam::DVec3::new(mean.x as f64, 0.0, mean.z as f64).try_normalize().unwrap_or(glam::DVec3::X),
+        };
+        let across = glam::DVec3::new(-along.z, 0.0, along.x);
         let ratio = (self.f_max / self.f_min) as f64;
+        let beta = self.beta as f64;
+        // ∫ f^(−β) df over [a, b].
+        let band_power = |a: f64, b: f64| {
+            if (beta - 1.0).abs() < 1e-9 {
+                (b / a).ln()
+            } else {
+                (b.powf(1.0 - beta) - a.powf(1.0 - beta)) / (1.0 - beta)
+            }
+        };
         let mut out = Vec::with_capacity(n);
         let mut power = 0.0f64;
         for i in 0..n {
+            let (lo, hi) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
             let u = (i as f64 + rng.unit()) / n as f64;
             let f = self.f_min as f64 * ratio.powf(u);
-            let a = f.powf((1.0 - self.beta as f64) / 2.0);
+            let a = band_power(self.f_min as f64 * ratio.powf(lo), self.f_min as f64 * ratio.powf(hi)).sqrt();
             let heading = rng.unit() * std::f64::consts::TAU;
             let tilt = (rng.unit() * 2.0 - 1.0) * self.vertical as f64;
             let dir = glam::DVec3::new(heading.cos(), tilt, heading.sin());
-            let kdir = rng.unit() * std::f64::consts::TAU;
+            let lateral = rng.unit() * 2.0 - 1.0;
             let kmag = std::f64::consts::TAU * f / self.mean_speed as f64;
+            let k = (along + across * lateral) * kmag;
             let phase = rng.unit();
             // Mean square of one horizontal component: a² · ½ · ½ (sin² and cos² of heading).
             power += a * a * 0.25;
-            out.push((dir * a, [kdir.cos() * kmag, 0.0, kdir.sin() * kmag], f, phase));
+            out.push((dir * a, [k.x, 0.0, k.z], f, phase));
         }
         let scale = if power > 0.0 { self.intensity as f64 / power.sqrt() } else { 0.0 };
         out.into_iter()
