@@ -15,6 +15,7 @@
 //! buffer copy on the GPU).
 
 pub mod akagi;
+pub mod fidelity;
 pub mod harness;
 pub mod plot;
 pub mod skjermo;

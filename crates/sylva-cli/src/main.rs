@@ -41,6 +41,9 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Reproduce a paper's result table on the CPU and the GPU, with plots.
     Bench(sylva_bench::BenchArgs),
+    /// Measure each method's motion as field studies measure trees (frequency against
+    /// DBH/H², damping against wind, bend, flutter) beside the field references.
+    Fidelity(sylva_bench::fidelity::FidelityArgs),
     /// Export a tree as glTF 2.0 (.glb/.gltf): mesh, materials, a skin and wind baked from
     /// any method (optionally looping), hierarchy attributes for engine wind shaders, LODs.
     Export(export_cmd::ExportArgs),
@@ -92,6 +95,12 @@ fn main() -> Result<()> {
         Some(Command::View(args)) => view_cmd::run(&args),
         Some(Command::Bench(args)) => {
             for p in sylva_bench::run(&args)? {
+                println!("wrote {}", p.display());
+            }
+            Ok(())
+        }
+        Some(Command::Fidelity(args)) => {
+            for p in sylva_bench::fidelity::run(&args)? {
                 println!("wrote {}", p.display());
             }
             Ok(())
@@ -158,6 +167,15 @@ fn summary(t: &Tree, seconds: f64) {
     }
     println!("  {:>5} {:>10} {:>8} {:>9}", "total", t.segments.len(), t.stems.len(), t.leaves.len());
     println!("  height {:.2} m, crown width {:.2} m, wood mass {:.1} kg", s.height, s.crown_width, s.mass);
+    if let Some(dbh) = t.dbh() {
+        let modes = sylva_core::physics::stem_frequencies(t, sylva_core::physics::MIN_RADIUS);
+        println!(
+            "  trunk diameter at breast height {:.3} m, DBH/H² {:.2e} 1/m, first mode {:.2} Hz",
+            dbh,
+            dbh / (s.height * s.height),
+            modes.hz(0)
+        );
+    }
     println!(
         "  model memory {:.2} MiB, max children per segment {}",
         s.memory_bytes as f64 / (1 << 20) as f64,

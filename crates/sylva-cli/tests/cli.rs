@@ -198,7 +198,18 @@ fn generate_prints_a_summary_and_writes_obj() {
     let (ok, out, err) =
         sylva(dir.path(), &["generate", "--species", "ternary", "--seed", "3", "--out", "t.obj", "--threads", "1"]);
     assert!(ok, "{err}");
-    for word in ["level", "segments", "stems", "leaves", "height", "crown width", "memory", "wrote t.obj"] {
+    for word in [
+        "level",
+        "segments",
+        "stems",
+        "leaves",
+        "height",
+        "crown width",
+        "breast height",
+        "first mode",
+        "memory",
+        "wrote t.obj",
+    ] {
         assert!(out.contains(word), "{word} missing:\n{out}");
     }
     assert!(dir.path().join("t.obj").exists());
@@ -758,4 +769,37 @@ fn viewer_without_a_display_says_so_and_points_to_render() {
     std::fs::write(dir.path().join("s.txt"), "frames 2\nteleport 3\n").unwrap();
     let (ok, _, err) = sylva(dir.path(), &["view", "--script", "s.txt"]);
     assert!(!ok && err.contains("s.txt:2") && err.contains("teleport"), "{err}");
+}
+
+#[test]
+fn fidelity_quick_measures_each_method_beside_the_field_references() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = ["fidelity", "--quick", "--species", "quaking_aspen", "--sizes", "0.5,0.7", "--methods", "akagi,zioma"];
+    let (ok, out, err) = sylva(dir.path(), &[&args[..], &["--out-dir", "f"]].concat());
+    assert!(ok, "{err}");
+    assert!(out.contains("Moore & Maguire") && out.contains("| akagi |"), "{out}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("f/fidelity.json")).unwrap()).unwrap();
+    let rows = json.as_array().unwrap();
+    assert_eq!(rows.len(), 4, "two sizes × two methods");
+    for r in rows {
+        let h = r["height"].as_f64().unwrap();
+        assert!(h > 1.0 && r["dbh"].as_f64().unwrap() > 0.0);
+        assert_eq!(r["steps"].as_array().unwrap().len(), 4);
+        assert!(r["sway_percent"].as_f64().unwrap() > 0.0, "{r}");
+        if r["method"] == "akagi" {
+            // Akagi rings down at its trunk's frequency in still air.
+            let f = r["frequency"].as_f64().expect("akagi rings after the pluck");
+            assert!(f > 0.05 && f < 5.0, "{f}");
+        }
+    }
+    let md = std::fs::read_to_string(dir.path().join("f/fidelity.md")).unwrap();
+    assert_eq!(md.lines().filter(|l| l.starts_with("| quaking_aspen")).count(), 4, "{md}");
+    for png in ["frequency.png", "damping.png", "bend.png"] {
+        assert_eq!(&std::fs::read(dir.path().join("f").join(png)).unwrap()[..4], b"\x89PNG", "{png}");
+    }
+    // Bad input names the flag.
+    let (ok, _, err) = sylva(dir.path(), &["fidelity", "--sizes", "0", "--out-dir", "g"]);
+    assert!(!ok && err.contains("--sizes") && err.contains("size factor"), "{err}");
+    assert!(!dir.path().join("g").exists());
 }

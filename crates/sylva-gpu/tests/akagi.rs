@@ -1,4 +1,4 @@
-//! Akagi's method: GPU vs CPU after 1,000 steps, on every preset.
+//! Akagi's method: GPU vs CPU after 240 steps, on every preset.
 
 mod common;
 
@@ -12,10 +12,12 @@ use sylva_gpu::methods::GpuAnimator;
 use sylva_gpu::methods::akagi::GpuAkagi;
 use sylva_gpu::wind::GpuWind;
 
-/// Joint positions within 1e-4 × tree height after 1,000 steps at 60 Hz in gusty wind: both
-/// sides run the same f32 operations in the same order (children summed in index order).
+/// Joint positions within 1e-4 × tree height after 240 steps (4 s) at 60 Hz in gusty wind:
+/// both sides run the same f32 operations in the same order (children summed in index
+/// order). Each step is one dispatch per depth of the tree, which a software rasteriser
+/// runs slowly: 240 steps keep the test to minutes on lavapipe.
 #[test]
-fn akagi_matches_after_1000_steps_on_every_preset() {
+fn akagi_matches_after_240_steps_on_every_preset() {
     let Some(ctx) = common::gpu() else { return };
     let wind = WindScene::resolve("gusty").unwrap();
     let fw = wind.packed();
@@ -24,7 +26,7 @@ fn akagi_matches_after_1000_steps_on_every_preset() {
         let a = Akagi::new(&t, AkagiParams::default());
         let mut cpu = a.rest_state(&t);
         let mut gpu = GpuAkagi::new(ctx, Arc::new(t.clone()), &a, &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
-        for _ in 0..1000 {
+        for _ in 0..240 {
             a.step(&t, &fw, &mut cpu, 1.0 / 60.0);
             gpu.step(ctx, 1.0 / 60.0);
         }

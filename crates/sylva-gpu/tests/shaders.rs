@@ -271,6 +271,7 @@ fn animation_structs_match_their_wgsl_twins() {
             ("dt", offset_of!(RawAkagiStep, dt)),
             ("reconfiguration_speed", offset_of!(RawAkagiStep, reconfiguration_speed)),
             ("stiffening_angle", offset_of!(RawAkagiStep, stiffening_angle)),
+            ("vogel_exponent", offset_of!(RawAkagiStep, vogel_exponent)),
             ("_pad", offset_of!(RawAkagiStep, _pad)),
         ],
     );

@@ -65,6 +65,9 @@ impl WoodProperties {
     }
 }
 
+/// Breast height, where forestry measures a trunk's diameter (DBH), m.
+pub const BREAST_HEIGHT: f32 = 1.3;
+
 /// Per-segment arrays (structure of arrays), in topological order.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Segments {
@@ -298,6 +301,26 @@ impl Tree {
     pub fn height(&self) -> f32 {
         let (lo, hi) = self.bounds();
         hi.y - lo.y
+    }
+
+    /// Trunk diameter at breast height (1.3 m above the trunk's base, along its axis), m; for
+    /// a trunk shorter than that, its diameter at mid-length. `None` without stems.
+    pub fn dbh(&self) -> Option<f32> {
+        let (st, s) = (&self.stems, &self.segments);
+        if st.is_empty() || st.segment_count[0] == 0 {
+            return None;
+        }
+        let (first, n) = (st.first_segment[0] as usize, st.segment_count[0] as usize);
+        let target = BREAST_HEIGHT.min(0.5 * st.length[0]);
+        let mut along = 0.0;
+        for i in first..first + n {
+            if along + s.length[i] >= target || i + 1 == first + n {
+                let f = ((target - along) / s.length[i].max(1e-9)).clamp(0.0, 1.0);
+                return Some(2.0 * (s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * f));
+            }
+            along += s.length[i];
+        }
+        None
     }
 
     /// Packed segments for GPU upload (see [`RawSegment`]).

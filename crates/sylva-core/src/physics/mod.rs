@@ -1,11 +1,23 @@
 //! The tree as a mechanical body, shared by every method: air, drag coefficients, the
-//! mechanical radius of a joint and the loads a stem carries. Methods keep their papers'
-//! mechanisms and take their constants from here.
+//! mechanical radius of a joint, the loads a stem carries, each stem's natural frequency
+//! ([`beam`]) and drag with reconfiguration and damping ([`drag`]). Methods keep their
+//! papers' mechanisms and take their constants from here.
+
+pub mod beam;
+pub mod drag;
+pub mod measure;
+
+pub use beam::{StemModes, stem_frequencies};
+pub use drag::{DragModel, STRUCTURAL_DAMPING};
 
 use crate::model::Tree;
 
 /// Air density at sea level, kg/m³.
 pub const AIR_DENSITY: f32 = 1.225;
+
+/// Thinnest radius a joint bends at, m. 1.5 mm: generators taper twigs toward zero for
+/// looks, but living twig tips are 2–5 mm thick.
+pub const MIN_RADIUS: f32 = 0.0015;
 
 /// Drag coefficient of bark and leaves together (a cylinder in cross-flow ≈ 1.0–1.2;
 /// leaves streamline in wind, lowering it).
@@ -23,6 +35,12 @@ pub fn mechanical_radii(tree: &Tree, min_radius: f32) -> Vec<f32> {
         r[i] = s.radius_base[i].max(min_radius).max(carried.sqrt());
     }
     r
+}
+
+/// Radius at which each segment bends, m: its own base radius (the section the tree is
+/// drawn with), never under `min_radius`.
+pub fn bending_radii(tree: &Tree, min_radius: f32) -> Vec<f32> {
+    tree.segments.radius_base.iter().map(|r| r.max(min_radius)).collect()
 }
 
 /// What one stem carries, as a rod turning about its base joint.

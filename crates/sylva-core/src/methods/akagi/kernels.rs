@@ -3,13 +3,16 @@
 
 use crate::methods::akagi::{RawAkagiSegment, RawAkagiStep};
 use crate::model::RawSegment;
-use crate::physics::AIR_DENSITY;
+use crate::physics::DragModel;
 use crate::wind::raw::{RawField, RawWave};
 use crate::wind::sample::wind_at;
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
-/// Own wind force on each segment at its current centre. Bindings: 0 fields, 1 waves,
+/// Own drag on each segment at its current centre, with its aerodynamic damping. `out`
+/// holds two entries per segment: `2i` the force (N) and, in w, the drag's rate of change
+/// with the segment's own velocity `γ = ρ C_d A |u| g(|u|)` (N·s/m: a part moving with the
+/// wind at v feels `F − γ v`); `2i + 1` the centre. Bindings: 0 fields, 1 waves,
 /// 2 segments, 3 akagi segments, 4 joints, 5 acc, 6 step, 7 forces.
 #[allow(clippy::too_many_arguments)]
 pub fn akagi_forces(
@@ -22,53 +25,70 @@ pub fn akagi_forces(
     step: RawAkagiStep,
     out: &mut [[f32; 4]],
 ) {
-    out.par_iter_mut().enumerate().for_each(|(i, o)| {
+    let drag = DragModel { reconfiguration_speed: step.reconfiguration_speed, vogel_exponent: step.vogel_exponent };
+    out.par_chunks_mut(2).enumerate().for_each(|(i, o)| {
         let s = &segments[i];
         let axis = Quat::from_array(acc[i]) * (Quat::from_array(s.orientation) * Vec3::Y);
         let centre = Vec3::new(joints[i][0], joints[i][1], joints[i][2]) + axis * (0.5 * s.length);
-        let v = wind_at(fields, waves, centre, step.time);
-        let u = v.length();
-        if u < 1e-6 {
-            *o = [0.0; 4];
-            return;
-        }
-        let vhat = v / u;
-        let sin_phi = vhat.cross(axis).length();
-        let area = akagi[i].bark_area * sin_phi + akagi[i].leaf_area;
-        // Streamlining above the reconfiguration speed: U² → U_r^0.7 · U^1.3.
-        let u2 =
-            if u > step.reconfiguration_speed { u * u * (step.reconfiguration_speed / u).powf(0.7) } else { u * u };
-        let f = vhat * (0.5 * AIR_DENSITY * step.drag * area * u2);
-        *o = [f.x, f.y, f.z, 0.0];
+        let w = wind_at(fields, waves, centre, step.time);
+        let u = w.length();
+        o[0] = if u < 1e-6 {
+            [0.0; 4]
+        } else {
+            let sin_phi = (w / u).cross(axis).length();
+            let cd_area = step.drag * (akagi[i].bark_area * sin_phi + akagi[i].leaf_area);
+            let f = drag.force(cd_area, w);
+            [f.x, f.y, f.z, drag.damping(cd_area, u)]
+        };
+        o[1] = [centre.x, centre.y, centre.z, 0.0];
     });
 }
 
-/// One depth of the propagation: `f_sub[i] = f_own[i] + Σ f_sub[children]` for the segments
-/// of `bucket` (their children were summed by the previous, deeper bucket). Bindings:
-/// 0 bucket, 1 child offsets, 2 child counts, 3 child indices, 4 own forces, 5 subtree forces.
+/// One depth of the propagation toward the root, for the segments of `bucket` (their
+/// children were summed by the previous, deeper bucket). With `f_j`, `γ_j` a segment's own
+/// drag and damping at its centre `x_j`, and `p` the joints, per joint i over everything
+/// beyond it, at `3i`, `3i + 1`, `3i + 2`:
+/// - the force `F = Σ f_j` and `S₀ = Σ γ_j`;
+/// - the moment about the joint `M = Σ (x_j − p_i) × f_j` and the aerodynamic damping of
+///   turning about it `Γ = Σ γ_j |x_j − p_i|²` (N·m·s/rad);
+/// - `S₁ = Σ γ_j (x_j − p_i)`, which carries Γ to the parent without cancellation.
+///
+/// Bindings: 0 bucket, 1 child offsets, 2 child counts, 3 child indices, 4 own forces,
+/// 5 joints, 6 sums.
 pub fn akagi_subtree(
     bucket: &[u32],
     offset: &[u32],
     count: &[u32],
     index: &[u32],
     f_own: &[[f32; 4]],
-    f_sub: &mut [[f32; 4]],
+    joints: &[[f32; 4]],
+    sub: &mut [[f32; 4]],
 ) {
-    let sums: Vec<(usize, [f32; 4])> = bucket
+    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let sums: Vec<(usize, [[f32; 4]; 3])> = bucket
         .par_iter()
         .map(|&i| {
             let i = i as usize;
-            let mut f = Vec3::new(f_own[i][0], f_own[i][1], f_own[i][2]);
+            let p = v(joints[i]);
+            let (mut f, mut s0) = (v(f_own[2 * i]), f_own[2 * i][3]);
+            let r = v(f_own[2 * i + 1]) - p;
+            let (mut m, mut s1, mut gamma) = (r.cross(f), r * s0, s0 * r.length_squared());
             let o = offset[i] as usize;
             for &c in &index[o..o + count[i] as usize] {
                 let c = c as usize;
-                f += Vec3::new(f_sub[c][0], f_sub[c][1], f_sub[c][2]);
+                let d = v(joints[c]) - p;
+                let (fc, s0c, s1c) = (v(sub[3 * c]), sub[3 * c][3], v(sub[3 * c + 2]));
+                f += fc;
+                m += v(sub[3 * c + 1]) + d.cross(fc);
+                gamma += sub[3 * c + 1][3] + 2.0 * d.dot(s1c) + d.length_squared() * s0c;
+                s1 += s1c + d * s0c;
+                s0 += s0c;
             }
-            (i, [f.x, f.y, f.z, 0.0])
+            (i, [[f.x, f.y, f.z, s0], [m.x, m.y, m.z, gamma], [s1.x, s1.y, s1.z, 0.0]])
         })
         .collect();
-    for (i, f) in sums {
-        f_sub[i] = f;
+    for (i, e) in sums {
+        sub[3 * i..3 * i + 3].copy_from_slice(&e);
     }
 }
 
@@ -82,13 +102,18 @@ pub fn quat_from_rotation_vector(t: Vec3) -> Quat {
     Quat::from_axis_angle(t / a, a)
 }
 
-/// Damped angular springs, implicit in stiffness and damping. Bindings: 0 segments,
-/// 1 akagi segments, 2 subtree forces, 3 acc, 4 step, 5 θ, 6 ω, 7 δ.
+/// Damped angular springs advanced by the exact solution of `J θ̈ + (c + Γ) θ̇ + k θ = τ`
+/// over the step with the moment, stiffness and damping held (so frequency and damping do
+/// not depend on the step, and the air's damping Γ is stable at any wind). The spring
+/// stiffens with the bend the moment holds it at ([`stiffening`]); its damping ratio stays. τ is the moment of
+/// everything beyond the joint about it, less its twist about the segment's axis, in the
+/// parent's rest frame. Bindings: 0 segments, 1 akagi segments, 2 the propagated sums
+/// ([`akagi_subtree`]), 3 acc, 4 step, 5 θ, 6 ω, 7 δ.
 #[allow(clippy::too_many_arguments)]
 pub fn akagi_integrate(
     segments: &[RawSegment],
     akagi: &[RawAkagiSegment],
-    f_sub: &[[f32; 4]],
+    sub: &[[f32; 4]],
     acc: &[[f32; 4]],
     step: RawAkagiStep,
     theta: &mut [[f32; 4]],
@@ -101,8 +126,9 @@ pub fn akagi_integrate(
             let a = &akagi[i];
             let d = Quat::from_array(acc[i]);
             let axis = d * (Quat::from_array(s.orientation) * Vec3::Y);
-            let f = Vec3::new(f_sub[i][0], f_sub[i][1], f_sub[i][2]);
-            let tau_world = axis.cross(f) * s.length;
+            let m = Vec3::new(sub[3 * i + 1][0], sub[3 * i + 1][1], sub[3 * i + 1][2]);
+            let gamma = sub[3 * i + 1][3];
+            let tau_world = m - axis * axis.dot(m);
             // Into the parent's rest frame: undo the parent's accumulated rotation, which is
             // this segment's accumulated rotation without its own.
             let own = quat_from_rotation_vector(Vec3::new(th[0], th[1], th[2]));
@@ -110,15 +136,55 @@ pub fn akagi_integrate(
             let tau = parent.inverse() * tau_world;
             let t0 = Vec3::new(th[0], th[1], th[2]);
             let w0 = Vec3::new(om[0], om[1], om[2]);
-            let dt = step.dt;
-            let r = t0.length() / step.stiffening_angle;
-            let k = a.stiffness * (1.0 + r * r);
-            let denom = 1.0 + dt * a.damping / a.inertia + dt * dt * k / a.inertia;
-            let w1 = (w0 + (tau - t0 * k) * (dt / a.inertia)) / denom;
-            let t1 = t0 + w1 * dt;
+            let stiffen = stiffening(tau.length() / a.stiffness, step.stiffening_angle);
+            let k = a.stiffness * stiffen;
+            let c = a.damping * stiffen.sqrt() + gamma;
+            let (mut t1, mut w1) = damped_step(t0, w0, tau / k, k / a.inertia, c / (2.0 * a.inertia), step.dt);
+            // A hard stop at three stiffening angles: the bend goes no further and stops
+            // moving outward.
+            let (bend, stop) = (t1.length(), 3.0 * step.stiffening_angle);
+            if bend > stop {
+                let n = t1 / bend;
+                t1 = n * stop;
+                w1 -= n * w1.dot(n).max(0.0);
+            }
             *th = [t1.x, t1.y, t1.z, 0.0];
             *om = [w1.x, w1.y, w1.z, 0.0];
             *de = quat_from_rotation_vector(t1).to_array();
         },
     );
+}
+
+/// How much a joint has stiffened at the bend the moment τ holds it at: the spring is
+/// `k (1 + (θ/θ_s)²)`, and its equilibrium under τ solves `θ + θ³/θ_s² = τ/k = b` (one real
+/// root: `θ = 2 θ_s/√3 · sinh(⅓ asinh(3√3 b / (2 θ_s)))`); returns `1 + (θ/θ_s)²`, the
+/// secant stiffness over `k`. Holding it over the step keeps the step exact and stable in
+/// any wind. WGSL: `stiffening` in `akagi_integrate.wgsl`.
+#[inline]
+pub fn stiffening(b: f32, theta_s: f32) -> f32 {
+    // θ / θ_s.
+    let u = 2.0 / 3f32.sqrt() * ((3.0 * 3f32.sqrt() * b / (2.0 * theta_s)).asinh() / 3.0).sinh();
+    1.0 + u * u
+}
+
+/// The exact step of `x¨ + 2 a x˙ + w² (x − x_eq) = 0` over `dt` from `(x0, v0)`:
+/// `(x1, v1)`, under- or overdamped. WGSL: the same lines in `akagi_integrate.wgsl`.
+#[inline]
+pub fn damped_step(x0: Vec3, v0: Vec3, x_eq: Vec3, w2: f32, a: f32, dt: f32) -> (Vec3, Vec3) {
+    // x(t) = C x0' + S (v0 + a x0'), v(t) = C v0 − S (a v0 + w² x0'), x0' = x0 − x_eq, with
+    // C = e^(−at) cos(ω_d t), S = e^(−at) sin(ω_d t) / ω_d (cosh and sinh when overdamped,
+    // written with exponentials that cannot overflow).
+    let disc = w2 - a * a;
+    let (c, s) = if disc > 0.0 {
+        let wd = disc.sqrt();
+        let e = (-a * dt).exp();
+        let (sn, cs) = (wd * dt).sin_cos();
+        (e * cs, e * sn / wd)
+    } else {
+        let b = (-disc).sqrt();
+        let (e1, e2) = (((b - a) * dt).exp(), (-(a + b) * dt).exp());
+        (0.5 * (e1 + e2), if b > 1e-6 { 0.5 * (e1 - e2) / b } else { e1 * dt })
+    };
+    let x = x0 - x_eq;
+    (x_eq + x * c + (v0 + x * a) * s, v0 * c - (v0 * a + x * w2) * s)
 }

@@ -1,23 +1,25 @@
-//! Akagi & Kitajima's sway by force propagation (§2.5), with the dynamics a real tool needs.
+//! Akagi & Kitajima's sway by force propagation (§2.5), with the dynamics of the wood.
 //!
 //! Each step:
-//! 1. **Forces** (`kernels::akagi_forces`): the wind at each segment's current centre
-//!    pushes on its bark, `½ ρ C_d (2 r̄ L |sin φ|) U² v̂` (φ between the segment and the
-//!    flow: a cylinder's projected area), and on its leaves, `½ ρ C_d A_leaf U² v̂`.
-//! 2. **Propagation** (`akagi_subtree`): each segment's force plus the summed forces of its
-//!    children, from the tips toward the root — one pass per depth of the hierarchy,
-//!    deepest first (the GPU runs one dispatch per depth).
-//! 3. **Rotation** (`akagi_integrate`): the component of that force perpendicular to the
-//!    segment, at its tip, gives the torque `τ = L (â × F)`; the segment turns about its
-//!    base against the rotational stiffness `k = E·I/L` (with the mechanical radius: the
-//!    model's, but never thinner than its children together, Leonardo's rule, nor than
-//!    `min_radius`) as a damped angular spring,
-//!    `I θ̈ = τ − k θ − c θ̇`, with `I` the subtree's moment of inertia about the joint and
-//!    `c = 2 ζ √(k I)`. Integration is implicit in the spring and damping terms, so it is
-//!    stable for any step. θ is a rotation vector in the parent's rest frame.
-//!    Two additions keep strong wind physical: drag grows as `U^1.3` above
-//!    `reconfiguration_speed` (leaves streamline, Vogel 1989), and the spring stiffens as
-//!    `k (1 + (|θ|/θ_s)²)` so joints do not spin through large angles.
+//! 1. **Forces** (`kernels::akagi_forces`): the wind at each segment's centre pushes on its
+//!    bark, `C_d (2 r̄ L |sin φ|)` (φ between the segment and the flow: a cylinder's
+//!    projected area), and on its leaves, `C_d,leaf A_leaf`, with drag that reconfigures in
+//!    strong wind, and damps the segment's own motion through the air
+//!    ([`crate::physics::DragModel`]).
+//! 2. **Propagation** (`akagi_subtree`): from the tips toward the root, one pass per depth
+//!    of the hierarchy (the GPU runs one dispatch per depth), the force on everything beyond
+//!    each joint, its moment about the joint — children's forces times their lever arms —
+//!    and the air's damping of turning about it, `Γ = Σ γ r²`.
+//! 3. **Rotation** (`akagi_integrate`): each joint is a spring `k = E·I/ℓ` of its segment's
+//!    section (never thinner than `min_radius`) and length — in a chain, these bend as the beam does under
+//!    the propagated moments. Its inertia is modal, `J = k/ω²` with ω its stem's first-mode
+//!    frequency from the wood, sections and carried mass
+//!    ([`crate::physics::stem_frequencies`]), so a stem sways at the tapered cantilever's
+//!    frequency and branches at their own, higher ones. `J θ̈ + (c + Γ) θ̇ + k θ = τ` with
+//!    `c = 2 ζ √(k J)` (structural damping) is advanced by its exact solution over the step,
+//!    so frequency and damping do not depend on the step. θ is a rotation vector in the
+//!    parent's rest frame; the spring stiffens as `k (1 + (|θ|/θ_s)²)` at the bend the
+//!    moment holds it at, and stops at `3 θ_s`, so joints do not spin through large angles.
 //! 4. **Pose**: rotations `δ = exp(θ)` applied root to tip through the seam.
 
 pub mod kernels;
@@ -38,14 +40,15 @@ use glam::Vec3;
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct AkagiParams {
-    /// Damping ratio ζ of every joint. Default 0.15: measured damping ratios of tree sway
-    /// are 0.05–0.3 (aerodynamic and internal damping together).
+    /// Structural damping ratio ζ of every joint (≤ 0.9). Default
+    /// [`crate::physics::STRUCTURAL_DAMPING`]; the air adds its own through the relative
+    /// velocity, rising with the wind.
     pub damping_ratio: f32,
     /// Drag coefficient of bark (a cylinder in cross-flow ≈ 1.0–1.2).
     pub drag: f32,
-    /// Effective drag coefficient per unit (one-sided) leaf area. Default 0.05: leaves in a
+    /// Effective drag coefficient per unit (one-sided) leaf area. Default 0.03: leaves in a
     /// crown shelter one another, so the sum over leaves must come to a crown's drag
-    /// (C_d ≈ 0.3 on the crown's frontal area, which for a broadleaf crown is 5–10 times
+    /// (C_d ≈ 0.2–0.3 on the crown's frontal area, which for a broadleaf crown is 5–10 times
     /// smaller than its leaf area).
     pub leaf_drag: f32,
     /// Substeps per `step` call.
@@ -54,25 +57,28 @@ pub struct AkagiParams {
     /// twigs toward zero for looks, but living twig tips are 2–5 mm thick; without a floor
     /// the stiffness `E·π r⁴/4L` of a tip vanishes and it spins in the wind.
     pub min_radius: f32,
-    /// Speed above which bark and leaves streamline, m/s: drag grows as `U^(2 − 0.7)`
-    /// beyond it instead of `U²` (Vogel 1989: leaves and crowns reconfigure in strong wind,
-    /// with Vogel exponents around −0.7).
+    /// Speed around which bark and leaves streamline, m/s (see
+    /// [`crate::physics::DragModel`]; default 5).
     pub reconfiguration_speed: f32,
+    /// Vogel exponent B: drag grows as `U^(2+B)` well above the reconfiguration speed
+    /// (default −0.7, Vogel 1989).
+    pub vogel_exponent: f32,
     /// Angle at which a joint has stiffened to twice its small-angle stiffness, rad: the
     /// spring is `k (1 + (|θ|/θ_s)²)` — wood stiffens and branches stop rotating as rigid
-    /// segments well before they turn by a radian.
+    /// segments well before they turn by a radian — and a joint bends at most `3 θ_s`.
     pub stiffening_angle: f32,
 }
 
 impl Default for AkagiParams {
     fn default() -> Self {
         Self {
-            damping_ratio: 0.15,
+            damping_ratio: crate::physics::STRUCTURAL_DAMPING,
             drag: 0.8,
-            leaf_drag: 0.05,
+            leaf_drag: 0.03,
             substeps: 1,
-            min_radius: 0.0015,
+            min_radius: crate::physics::MIN_RADIUS,
             reconfiguration_speed: 5.0,
+            vogel_exponent: -0.7,
             stiffening_angle: 0.5,
         }
     }
@@ -82,7 +88,8 @@ impl AkagiParams {
     /// Checks every field's range.
     pub fn check(&self) -> Result<(), MethodError> {
         let m = "akagi";
-        check(m, "damping_ratio", self.damping_ratio, (0.0..=10.0).contains(&self.damping_ratio), "0 to 10")?;
+        check(m, "damping_ratio", self.damping_ratio, (0.0..=0.9).contains(&self.damping_ratio), "0 to 0.9")?;
+        check(m, "vogel_exponent", self.vogel_exponent, (-2.0..=0.0).contains(&self.vogel_exponent), "−2 to 0")?;
         check(m, "drag", self.drag, self.drag >= 0.0, "a finite number ≥ 0")?;
         check(m, "leaf_drag", self.leaf_drag, self.leaf_drag >= 0.0, "a finite number ≥ 0")?;
         check(m, "substeps", self.substeps as f32, (1..=1000).contains(&self.substeps), "1 to 1000")?;
@@ -135,42 +142,31 @@ pub struct Akagi {
 }
 
 impl Akagi {
-    /// Precomputes areas, subtree inertia, stiffness, damping and the depth buckets.
+    /// Precomputes areas, stiffness, modal inertia, damping and the depth buckets.
     pub fn new(tree: &Tree, params: AkagiParams) -> Self {
         let s = &tree.segments;
         let n = s.len();
-        let leaf_mass_per_area = tree.wood.leaf_areal_density;
         let mut leaf_area = vec![0.0f32; n];
         for (k, &seg) in tree.leaves.segment.iter().enumerate() {
             leaf_area[seg as usize] += std::f32::consts::FRAC_PI_4 * tree.leaves.width[k] * tree.leaves.length[k];
         }
-        // Subtree mass and inertia about each joint, tips first (children have larger indices).
-        let mut mass = vec![0.0f32; n];
-        let mut inertia = vec![0.0f32; n];
-        for i in (0..n).rev() {
-            let l = s.length[i];
-            let m = s.mass[i] + leaf_area[i] * leaf_mass_per_area;
-            let mut m_sub = m;
-            let mut inert = m * l * l / 3.0;
-            for &c in tree.children.of(i) {
-                let c = c as usize;
-                let d = (s.start[c] - s.start[i]).length_squared();
-                m_sub += mass[c];
-                inert += inertia[c] + mass[c] * d;
-            }
-            mass[i] = m_sub;
-            inertia[i] = inert.max(1e-12);
-        }
-        let r_mech = crate::physics::mechanical_radii(tree, params.min_radius);
+        let r_mech = crate::physics::bending_radii(tree, params.min_radius);
+        let modes = crate::physics::beam::stem_frequencies_with(tree, &r_mech);
         let segments = (0..n)
             .map(|i| {
-                let k = tree.wood.segment_stiffness(s.length[i], r_mech[i]);
+                let k = tree.wood.segment_stiffness(s.length[i], r_mech[i]).max(1e-12);
+                let mut w = modes.omega[s.stem[i] as usize];
+                if !(w.is_finite() && w > 0.0) {
+                    // A stem with no mass or compliance: a rod of its subtree's mass.
+                    w = (3.0 * k / (modes.subtree_mass[i] * s.length[i] * s.length[i]).max(1e-12)).sqrt();
+                }
+                let inertia = (k / (w * w)).max(1e-12);
                 RawAkagiSegment {
                     bark_area: (s.radius_base[i] + s.radius_tip[i]) * s.length[i],
                     leaf_area: leaf_area[i] * params.leaf_drag / params.drag.max(1e-6),
-                    inertia: inertia[i],
+                    inertia,
                     stiffness: k,
-                    damping: 2.0 * params.damping_ratio * (k * inertia[i]).sqrt(),
+                    damping: 2.0 * params.damping_ratio * (k * inertia).sqrt(),
                     _pad: [0; 3],
                 }
             })
@@ -190,11 +186,12 @@ impl Akagi {
             dt,
             reconfiguration_speed: self.params.reconfiguration_speed,
             stiffening_angle: self.params.stiffening_angle,
-            _pad: [0.0; 3],
+            vogel_exponent: self.params.vogel_exponent,
+            _pad: [0.0; 2],
         }
     }
 
-    /// Natural angular frequency √(k/I) of segment `i`'s joint, rad/s.
+    /// Natural angular frequency √(k/J) of segment `i`'s joint (its stem's first mode), rad/s.
     pub fn natural_frequency(&self, i: usize) -> f32 {
         (self.segments[i].stiffness / self.segments[i].inertia).sqrt()
     }
@@ -222,28 +219,29 @@ impl Method for Akagi {
         let (fields, waves) = (&wind.fields[..], &wind.waves[..]);
         let n = tree.segments.len();
         let sub = dt / self.params.substeps.max(1) as f32;
-        let mut f_own = vec![[0.0f32; 4]; n];
-        let mut f_sub = vec![[0.0f32; 4]; n];
+        let mut forces = vec![[0.0f32; 4]; 2 * n];
+        let mut sums = vec![[0.0f32; 4]; 3 * n];
         let mut delta = vec![[0.0f32; 4]; n];
         let mut joints: Vec<[f32; 4]> = state.pose.start.iter().map(|p| p.extend(0.0).to_array()).collect();
         for _ in 0..self.params.substeps.max(1) {
             let t = state.time + sub;
             let step = self.step_params(t, sub);
-            akagi_forces(fields, waves, &self.raw, &self.segments, &joints, &state.acc, step, &mut f_own);
+            akagi_forces(fields, waves, &self.raw, &self.segments, &joints, &state.acc, step, &mut forces);
             for bucket in &self.buckets {
                 akagi_subtree(
                     bucket,
                     &tree.children.offset,
                     &tree.children.count,
                     &tree.children.index,
-                    &f_own,
-                    &mut f_sub,
+                    &forces,
+                    &joints,
+                    &mut sums,
                 );
             }
             akagi_integrate(
                 &self.raw,
                 &self.segments,
-                &f_sub,
+                &sums,
                 &state.acc,
                 step,
                 &mut state.theta,

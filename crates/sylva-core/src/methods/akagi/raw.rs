@@ -11,11 +11,12 @@ pub struct RawAkagiSegment {
     /// Leaf area on the segment scaled by `leaf_drag / drag`, so one coefficient serves
     /// both: m².
     pub leaf_area: f32,
-    /// Moment of inertia of the subtree about the joint, kg·m².
+    /// Modal inertia of the joint `J = k / ω²`, with ω its stem's first-mode frequency,
+    /// kg·m².
     pub inertia: f32,
     /// Rotational stiffness, N·m/rad.
     pub stiffness: f32,
-    /// Damping, N·m·s/rad.
+    /// Structural damping `c = 2 ζ √(k J)`, N·m·s/rad.
     pub damping: f32,
     /// Padding.
     pub _pad: [u32; 3],
@@ -35,6 +36,8 @@ pub struct RawAkagiStep {
     pub reconfiguration_speed: f32,
     /// See [`AkagiParams::stiffening_angle`].
     pub stiffening_angle: f32,
+    /// See [`AkagiParams::vogel_exponent`].
+    pub vogel_exponent: f32,
     /// Padding.
-    pub _pad: [f32; 3],
+    pub _pad: [f32; 2],
 }

@@ -1,5 +1,5 @@
 // Shared by Akagi's kernels: per-segment constants and per-step parameters.
-// Twins: sylva_core::methods::akagi::RawAkagiSegment and the (drag, time, dt) arguments.
+// Twins: sylva_core::methods::akagi::RawAkagiSegment and RawAkagiStep.
 
 struct AkagiSegment {
     bark_area: f32,
@@ -16,7 +16,8 @@ struct AkagiStep {
     dt: f32,
     reconfiguration_speed: f32,
     stiffening_angle: f32,
-    _pad: array<f32, 3>,
+    vogel_exponent: f32,
+    _pad: array<f32, 2>,
 }
 
 const AIR_DENSITY: f32 = 1.225;

@@ -1,6 +1,7 @@
-// akagi_forces: own wind force on each segment at its current centre. CPU twin:
-// sylva_core::methods::akagi::kernels::akagi_forces (bindings 0 fields, 1 waves, 2 segments,
-// 3 akagi segments, 4 joints, 5 acc, 6 step, 7 forces).
+// akagi_forces: own drag on each segment at its current centre, with its aerodynamic damping.
+// Two entries per segment: 2i the force (w: the damping gamma = rho Cd A |u| g(|u|), N s/m),
+// 2i + 1 the centre. CPU twin: sylva_core::methods::akagi::kernels::akagi_forces (bindings
+// 0 fields, 1 waves, 2 segments, 3 akagi segments, 4 joints, 5 acc, 6 step, 7 forces).
 
 @group(0) @binding(2) var<storage, read> segments: array<Segment>;
 @group(0) @binding(3) var<storage, read> akagi: array<AkagiSegment>;
@@ -18,19 +19,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let s = segments[i];
     let axis = quat_rotate(acc[i], quat_rotate(s.orientation, vec3<f32>(0.0, 1.0, 0.0)));
     let centre = joints[i].xyz + axis * (0.5 * s.length);
-    let v = wind_at(centre, step.time);
-    let u = length(v);
-    if (u < 1e-6) {
-        forces[i] = vec4<f32>(0.0);
-        return;
+    let w = wind_at(centre, step.time);
+    let u = length(w);
+    var f = vec4<f32>(0.0);
+    if (u >= 1e-6) {
+        let sin_phi = length(cross(w / u, axis));
+        let cd_area = step.drag * (akagi[i].bark_area * sin_phi + akagi[i].leaf_area);
+        // Drag with reconfiguration, (1 + (u/U_r)^2)^(B/2) on u^2 (physics::DragModel).
+        let r = u / step.reconfiguration_speed;
+        let g = pow(1.0 + r * r, 0.5 * step.vogel_exponent);
+        f = vec4<f32>(w * (0.5 * AIR_DENSITY * cd_area * u * g), AIR_DENSITY * cd_area * u * g);
     }
-    let vhat = v / u;
-    let sin_phi = length(cross(vhat, axis));
-    let area = akagi[i].bark_area * sin_phi + akagi[i].leaf_area;
-    // Streamlining above the reconfiguration speed: U^2 -> U_r^0.7 U^1.3.
-    var u2 = u * u;
-    if (u > step.reconfiguration_speed) {
-        u2 = u * u * pow(step.reconfiguration_speed / u, 0.7);
-    }
-    forces[i] = vec4<f32>(vhat * (0.5 * AIR_DENSITY * step.drag * area * u2), 0.0);
+    forces[2u * i] = f;
+    forces[2u * i + 1u] = vec4<f32>(centre, 0.0);
 }

@@ -1,15 +1,23 @@
-// akagi_integrate: damped angular springs, implicit in stiffness and damping. CPU twin:
+// akagi_integrate: damped angular springs advanced by the exact solution of
+// J theta'' + (c + Gamma) theta' + k theta = tau over the step, with the moment, the stiffness
+// (stiffened at the bend the moment holds) and the damping held. CPU twin:
 // sylva_core::methods::akagi::kernels::akagi_integrate (bindings 0 segments, 1 akagi segments,
-// 2 subtree forces, 3 acc, 4 step, 5 theta, 6 omega, 7 delta).
+// 2 propagated sums, 3 acc, 4 step, 5 theta, 6 omega, 7 delta).
 
 @group(0) @binding(0) var<storage, read> segments: array<Segment>;
 @group(0) @binding(1) var<storage, read> akagi: array<AkagiSegment>;
-@group(0) @binding(2) var<storage, read> f_sub: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> sub: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> acc: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> step: AkagiStep;
 @group(0) @binding(5) var<storage, read_write> theta: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> omega: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read_write> delta: array<vec4<f32>>;
+
+// 1 + (theta/theta_s)^2 at the equilibrium of theta + theta^3/theta_s^2 = b (kernels::stiffening).
+fn stiffening(b: f32, theta_s: f32) -> f32 {
+    let u = 2.0 / sqrt(3.0) * sinh(asinh(3.0 * sqrt(3.0) * b / (2.0 * theta_s)) / 3.0);
+    return 1.0 + u * u;
+}
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -21,18 +29,51 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let a = akagi[i];
     let d = acc[i];
     let axis = quat_rotate(d, quat_rotate(s.orientation, vec3<f32>(0.0, 1.0, 0.0)));
-    let tau_world = cross(axis, f_sub[i].xyz) * s.length;
+    let m = sub[3u * i + 1u].xyz;
+    let gamma = sub[3u * i + 1u].w;
+    let tau_world = m - axis * dot(axis, m);
     let own = quat_from_rotation_vector(theta[i].xyz);
     let parent = quat_mul(d, quat_conj(own));
     let tau = quat_rotate(quat_conj(parent), tau_world);
     let t0 = theta[i].xyz;
     let w0 = omega[i].xyz;
-    let dt = step.dt;
-    let r = length(t0) / step.stiffening_angle;
-    let k = a.stiffness * (1.0 + r * r);
-    let denom = 1.0 + dt * a.damping / a.inertia + dt * dt * k / a.inertia;
-    let w1 = (w0 + (tau - t0 * k) * (dt / a.inertia)) / denom;
-    let t1 = t0 + w1 * dt;
+    let stiffen = stiffening(length(tau) / a.stiffness, step.stiffening_angle);
+    let k = a.stiffness * stiffen;
+    let c = a.damping * sqrt(stiffen) + gamma;
+    // The exact step of x'' + 2 a x' + w2 (x - x_eq) = 0 (kernels::damped_step).
+    let w2 = k / a.inertia;
+    let damp = c / (2.0 * a.inertia);
+    let disc = w2 - damp * damp;
+    var cc: f32;
+    var ss: f32;
+    if (disc > 0.0) {
+        let wd = sqrt(disc);
+        let e = exp(-damp * step.dt);
+        cc = e * cos(wd * step.dt);
+        ss = e * sin(wd * step.dt) / wd;
+    } else {
+        let b = sqrt(-disc);
+        let e1 = exp((b - damp) * step.dt);
+        let e2 = exp(-(damp + b) * step.dt);
+        cc = 0.5 * (e1 + e2);
+        if (b > 1e-6) {
+            ss = 0.5 * (e1 - e2) / b;
+        } else {
+            ss = e1 * step.dt;
+        }
+    }
+    let x_eq = tau / k;
+    let x = t0 - x_eq;
+    var t1 = x_eq + x * cc + (w0 + x * damp) * ss;
+    var w1 = w0 * cc - (w0 * damp + x * w2) * ss;
+    // The hard stop at three stiffening angles.
+    let bend = length(t1);
+    let stop = 3.0 * step.stiffening_angle;
+    if (bend > stop) {
+        let n = t1 / bend;
+        t1 = n * stop;
+        w1 -= n * max(dot(w1, n), 0.0);
+    }
     theta[i] = vec4<f32>(t1, 0.0);
     omega[i] = vec4<f32>(w1, 0.0);
     delta[i] = quat_from_rotation_vector(t1);

@@ -29,8 +29,10 @@ pub struct GpuAkagi {
     child_offset: wgpu::Buffer,
     child_count: wgpu::Buffer,
     child_index: wgpu::Buffer,
+    /// Own drag and centre per segment (two entries each).
     f_own: wgpu::Buffer,
-    f_sub: wgpu::Buffer,
+    /// Force, moment and damping beyond each joint (three entries each).
+    sub: wgpu::Buffer,
     theta: wgpu::Buffer,
     omega: wgpu::Buffer,
     /// Simulated time, s.
@@ -59,8 +61,8 @@ impl GpuAkagi {
             child_offset: upload(ctx, "child offsets", &c.offset)?,
             child_count: upload(ctx, "child counts", &c.count)?,
             child_index: upload(ctx, "child indices", &index)?,
-            f_own: output::<[f32; 4]>(ctx, "own forces", n)?,
-            f_sub: output::<[f32; 4]>(ctx, "subtree forces", n)?,
+            f_own: output::<[f32; 4]>(ctx, "own forces", 2 * n)?,
+            sub: output::<[f32; 4]>(ctx, "subtree sums", 3 * n)?,
             theta: output::<[f32; 4]>(ctx, "theta", n)?,
             omega: output::<[f32; 4]>(ctx, "omega", n)?,
             time: 0.0,
@@ -88,14 +90,14 @@ impl GpuAkagi {
             self.subtree.record(
                 ctx,
                 &mut e,
-                &[bucket, &self.child_offset, &self.child_count, &self.child_index, &self.f_own, &self.f_sub],
+                &[bucket, &self.child_offset, &self.child_count, &self.child_index, &self.f_own, joints, &self.sub],
                 *len,
             );
         }
         self.integrate.record(
             ctx,
             &mut e,
-            &[&self.segments, &self.akagi, &self.f_sub, acc, &self.step, &self.theta, &self.omega, delta],
+            &[&self.segments, &self.akagi, &self.sub, acc, &self.step, &self.theta, &self.omega, delta],
             n,
         );
         self.pose.record(ctx, &mut e);

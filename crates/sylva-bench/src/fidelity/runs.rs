@@ -1,0 +1,213 @@
+//! The runs of `sylva fidelity`: a tree of a size series, and what one method does with it
+//! in a pluck, step responses and gusts.
+
+use anyhow::{Context, Result, bail};
+use glam::Vec3;
+use rustfft::{FftPlanner, num_complex::Complex};
+use std::sync::Arc;
+use sylva_core::Tree;
+use sylva_core::methods::{Animator, MethodOptions};
+use sylva_core::physics::measure::{damping_ratio, sway_frequency};
+use sylva_core::species::SpeciesSource;
+use sylva_core::wind::{Constant, WindField, WindScene};
+
+/// The field references the report sets its figures beside.
+pub const FIELD: &str = "sway 0.2–1 Hz for 10–30 m trees, linear in DBH/H² (Moore & Maguire 2004, \
+602 trees); damping ratio 0.02–0.2, rising with wind speed; trunk-top sway 0.5–3 % of height in a \
+moderate breeze; branches with frequencies of their own above the trunk's.";
+
+/// How long each run lasts.
+#[derive(Debug, Clone, Copy)]
+pub struct Protocol {
+    /// Seconds of steady wind before the pluck's release.
+    pub load: f32,
+    /// Seconds of ringing after it.
+    pub ring: f32,
+    /// Seconds of each step response.
+    pub step: f32,
+    /// Seconds of gusts (the first 10 s are not measured).
+    pub gusty: f32,
+}
+
+impl Protocol {
+    /// The default runs.
+    pub const FULL: Self = Self { load: 3.0, ring: 25.0, step: 25.0, gusty: 70.0 };
+    /// `--quick`.
+    pub const QUICK: Self = Self { load: 2.0, ring: 12.0, step: 10.0, gusty: 30.0 };
+}
+
+/// Wind speeds of the step responses, m/s.
+pub const STEP_SPEEDS: [f32; 4] = [3.0, 6.0, 10.0, 15.0];
+
+/// One step response.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StepRow {
+    /// Wind speed, m/s.
+    pub speed: f32,
+    /// Mean downwind displacement of the trunk top over the last fifth, % of height.
+    pub lean_percent: f32,
+    /// Damping ratio of the ringing about it (None: it did not ring).
+    pub damping: Option<f32>,
+}
+
+/// What one method does with one tree.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Row {
+    /// Species.
+    pub species: String,
+    /// Size factor.
+    pub size: f64,
+    /// Method.
+    pub method: String,
+    /// Tree height, m.
+    pub height: f32,
+    /// Trunk diameter at breast height, m.
+    pub dbh: f32,
+    /// DBH / H², 1/m.
+    pub dbh_over_h2: f32,
+    /// Trunk-top sway frequency after the pluck, Hz.
+    pub frequency: Option<f32>,
+    /// Damping ratio of the pluck's ringing in still air.
+    pub damping_still: Option<f32>,
+    /// Step responses at [`STEP_SPEEDS`].
+    pub steps: Vec<StepRow>,
+    /// Standard deviation of the trunk top's horizontal motion in gusty wind, % of height.
+    pub sway_percent: f32,
+    /// Per stem level 0, 1, 2: share of the variance of the tips' motion relative to their
+    /// stem's base that lies above 1.5 Hz (None: no stems at that level).
+    pub flutter: [Option<f32>; 3],
+}
+
+/// A Weber–Penn species with its size (`scale`) times `factor`.
+pub fn grow(species: &str, factor: f64) -> Result<Arc<Tree>> {
+    let SpeciesSource::WeberPenn { file, mut params } = SpeciesSource::resolve(species)? else {
+        bail!("--species {species}: a size series needs a Weber–Penn species (a grammar has no `scale`)");
+    };
+    params.scale *= factor;
+    params.scale_v *= factor;
+    let tree = SpeciesSource::WeberPenn { file, params }
+        .generate(1, &Default::default(), None)
+        .with_context(|| format!("growing {species} ×{factor}"))?;
+    Ok(Arc::new(tree))
+}
+
+fn constant(speed: f32) -> Arc<sylva_core::wind::PackedWind> {
+    let scene = WindScene { fields: vec![WindField::Constant(Constant { direction: [1.0, 0.0, 0.0], speed })] };
+    Arc::new(scene.packed())
+}
+
+/// Steps `anim` `seconds` long, recording `probe` of the pose after each step.
+fn record<T>(
+    anim: &mut dyn Animator,
+    dt: f32,
+    seconds: f32,
+    mut probe: impl FnMut(&sylva_core::pose::Pose) -> T,
+) -> Vec<T> {
+    (0..(seconds / dt).round() as usize)
+        .map(|_| {
+            anim.step(dt);
+            probe(&anim.pose())
+        })
+        .collect()
+}
+
+/// Share of a series' variance above `f` Hz.
+fn share_above(series: &[f32], dt: f32, f: f32) -> (f32, f32) {
+    let n = series.len();
+    let mean = series.iter().sum::<f32>() / n.max(1) as f32;
+    let mut buf: Vec<Complex<f32>> = series.iter().map(|&x| Complex::new(x - mean, 0.0)).collect();
+    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
+    let df = 1.0 / (n as f32 * dt);
+    let (mut hi, mut all) = (0.0, 0.0);
+    for (k, c) in buf.iter().enumerate().take(n / 2).skip(1) {
+        all += c.norm_sqr();
+        if k as f32 * df > f {
+            hi += c.norm_sqr();
+        }
+    }
+    (hi, all)
+}
+
+/// Runs the pluck, the step responses and the gusts of `method` on `tree`.
+pub fn measure(
+    registry: &sylva_runtime::MethodRegistry,
+    method: &str,
+    species: &str,
+    size: f64,
+    tree: Arc<Tree>,
+    p: Protocol,
+    dt: f32,
+) -> Result<Row> {
+    let t = &*tree;
+    let mut anim = registry.cpu(method, tree.clone(), &MethodOptions::default())?;
+    let top = (t.stems.first_segment[0] + t.stems.segment_count[0] - 1) as usize;
+    let rest = t.segments.end(top);
+    let height = t.height();
+    let dx = |pose: &sylva_core::pose::Pose| (pose.end(t, top) - rest).x;
+    // Pluck.
+    anim.set_wind(constant(6.0));
+    anim.reset(0.0);
+    record(&mut *anim, dt, p.load, dx);
+    anim.set_wind(Arc::new(WindScene::default().packed()));
+    let ring = record(&mut *anim, dt, p.ring, dx);
+    let peak = ring.iter().fold(0.0f32, |a, v| a.max(v.abs()));
+    let frequency = sway_frequency(&ring, dt);
+    let damping_still = damping_ratio(&ring, 0.0, 0.05 * peak);
+    // Step responses.
+    let mut steps = Vec::new();
+    for speed in STEP_SPEEDS {
+        anim.set_wind(constant(speed));
+        anim.reset(0.0);
+        let x = record(&mut *anim, dt, p.step, dx);
+        let tail = &x[x.len() * 4 / 5..];
+        let lean = tail.iter().sum::<f32>() / tail.len().max(1) as f32;
+        let peak = x.iter().fold(0.0f32, |a, v| a.max((v - lean).abs()));
+        steps.push(StepRow {
+            speed,
+            lean_percent: 100.0 * lean / height,
+            damping: damping_ratio(&x, lean, 0.05 * peak),
+        });
+    }
+    // Gusts: the trunk top, and the tips of each level relative to their stem's base.
+    let st = &t.stems;
+    let level_of = |k: usize| t.segments.level[st.first_segment[k] as usize] as usize;
+    let tips: Vec<(usize, usize, usize)> = (0..st.len())
+        .filter(|&k| level_of(k) <= 2 && st.segment_count[k] > 0)
+        .map(|k| (level_of(k), st.first_segment[k] as usize, (st.first_segment[k] + st.segment_count[k] - 1) as usize))
+        .collect();
+    anim.set_wind(Arc::new(WindScene::resolve("gusty")?.packed()));
+    anim.reset(0.0);
+    let samples = record(&mut *anim, dt, p.gusty, |pose| {
+        let mut v = vec![pose.end(t, top)];
+        v.extend(tips.iter().map(|&(_, base, tip)| pose.end(t, tip) - pose.start[base]));
+        v
+    });
+    let skip = ((10.0 / dt) as usize).min(samples.len() / 2);
+    let samples = &samples[skip..];
+    let n = samples.len().max(1) as f32;
+    let mean = samples.iter().map(|s| s[0]).sum::<Vec3>() / n;
+    let var = samples.iter().map(|s| ((s[0] - mean) * Vec3::new(1.0, 0.0, 1.0)).length_squared()).sum::<f32>() / n;
+    let mut flutter = [(0.0f32, 0.0f32); 3];
+    for (j, &(level, _, _)) in tips.iter().enumerate() {
+        for c in 0..3 {
+            let series: Vec<f32> = samples.iter().map(|s| s[j + 1][c]).collect();
+            let (hi, all) = share_above(&series, dt, 1.5);
+            flutter[level].0 += hi;
+            flutter[level].1 += all;
+        }
+    }
+    let dbh = t.dbh().unwrap_or(0.0);
+    Ok(Row {
+        species: species.to_string(),
+        size,
+        method: method.to_string(),
+        height,
+        dbh,
+        dbh_over_h2: dbh / (height * height),
+        frequency,
+        damping_still,
+        steps,
+        sway_percent: 100.0 * var.sqrt() / height,
+        flutter: flutter.map(|(hi, all)| (all > 0.0).then(|| hi / all)),
+    })
+}

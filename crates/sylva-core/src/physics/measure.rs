@@ -1,0 +1,82 @@
+//! Reading a tree's motion the way field studies do: sway frequency from zero crossings,
+//! damping ratio from the logarithmic decrement of successive peaks, and least-squares lines
+//! (frequency against DBH/H²).
+
+/// Frequency of an oscillating series sampled every `dt` s, Hz: upward crossings of its mean
+/// over the span between the first and the last. `None` with fewer than three crossings.
+pub fn sway_frequency(series: &[f32], dt: f32) -> Option<f32> {
+    let mean = series.iter().map(|&x| x as f64).sum::<f64>() / series.len().max(1) as f64;
+    let mut crossings = Vec::new();
+    for k in 1..series.len() {
+        let (a, b) = (series[k - 1] as f64 - mean, series[k] as f64 - mean);
+        if a < 0.0 && b >= 0.0 {
+            crossings.push((k - 1) as f64 + a / (a - b));
+        }
+    }
+    if crossings.len() < 3 {
+        return None;
+    }
+    let span = crossings[crossings.len() - 1] - crossings[0];
+    Some(((crossings.len() - 1) as f64 / (span * dt as f64)) as f32)
+}
+
+/// Damping ratio of a decaying oscillation about `centre`, from the logarithmic decrement
+/// of successive peaks of |x − centre| (a half-period apart): the slope of ln(peak) against
+/// the peak's number, fitted over every peak above `floor`, is −δ/2, and
+/// `ζ = δ / √(4π² + δ²)`. `None` with fewer than three peaks, or when the peaks do not decay
+/// as one exponential (fit R² under 0.7: motion that is driven, not ringing down).
+pub fn damping_ratio(series: &[f32], centre: f32, floor: f32) -> Option<f32> {
+    let mut peaks = Vec::new();
+    for k in 1..series.len().saturating_sub(1) {
+        let (a, b, c) = ((series[k - 1] - centre).abs(), (series[k] - centre).abs(), (series[k + 1] - centre).abs());
+        if b > a && b >= c && b > floor {
+            peaks.push((peaks.len() as f64, (b as f64).ln()));
+        }
+    }
+    if peaks.len() < 3 {
+        return None;
+    }
+    let (slope, _, r2) = linear_fit(&peaks);
+    if slope >= 0.0 || r2 < 0.7 {
+        return None;
+    }
+    let delta = -2.0 * slope;
+    Some((delta / (4.0 * std::f64::consts::PI * std::f64::consts::PI + delta * delta).sqrt()) as f32)
+}
+
+/// Least-squares line through `(x, y)`: (slope, intercept, R²).
+pub fn linear_fit(points: &[(f64, f64)]) -> (f64, f64, f64) {
+    let n = points.len() as f64;
+    let (sx, sy) = (points.iter().map(|p| p.0).sum::<f64>(), points.iter().map(|p| p.1).sum::<f64>());
+    let (mx, my) = (sx / n, sy / n);
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let syy: f64 = points.iter().map(|p| (p.1 - my) * (p.1 - my)).sum();
+    let slope = sxy / sxx;
+    let r2 = if syy > 0.0 { sxy * sxy / (sxx * syy) } else { 1.0 };
+    (slope, my - slope * mx, r2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A damped sine of known frequency and damping ratio reads back as both; a sum of
+    /// incommensurate sines (driven motion) has no damping ratio.
+    #[test]
+    fn a_damped_sine_reads_back_its_frequency_and_damping() {
+        let (f, zeta, dt) = (0.7f32, 0.05f32, 1.0 / 120.0);
+        let w = std::f32::consts::TAU * f;
+        let wd = w * (1.0 - zeta * zeta).sqrt();
+        let x: Vec<f32> = (0..6000).map(|k| k as f32 * dt).map(|t| (-zeta * w * t).exp() * (wd * t).cos()).collect();
+        let fm = sway_frequency(&x, dt).unwrap();
+        assert!((fm / (wd / std::f32::consts::TAU) - 1.0).abs() < 0.01, "{fm}");
+        let z = damping_ratio(&x, 0.0, 0.01).unwrap();
+        assert!((z / zeta - 1.0).abs() < 0.05, "{z}");
+        let driven: Vec<f32> =
+            (0..6000).map(|k| k as f32 * dt).map(|t| t.sin() + (2.7 * t).sin() + (5.1 * t).cos()).collect();
+        assert_eq!(damping_ratio(&driven, 0.0, 0.01), None);
+        let (slope, icpt, r2) = linear_fit(&[(0.0, 1.0), (1.0, 3.0), (2.0, 5.0)]);
+        assert!((slope - 2.0).abs() < 1e-12 && (icpt - 1.0).abs() < 1e-12 && (r2 - 1.0).abs() < 1e-12);
+    }
+}
