@@ -1,4 +1,4 @@
-//! Skjermo's method: GPU vs CPU after 1,000 steps, on every preset.
+//! Skjermo's method: GPU vs CPU after 240 steps, on every preset.
 
 mod common;
 
@@ -11,10 +11,11 @@ use sylva_core::wind::WindScene;
 use sylva_gpu::methods::skjermo::GpuSkjermo;
 use sylva_gpu::wind::GpuWind;
 
-/// Joint positions and control points within 1e-4 × tree height after 1,000 steps at 60 Hz
-/// in gusty wind.
+/// Joint positions and control points within 1e-4 × tree height after 240 steps (4 s) at
+/// 60 Hz in gusty wind (level d answers d steps late: every level has moved long before).
+/// One submission per step runs slowly on a software rasteriser: 240 keep it to minutes.
 #[test]
-fn skjermo_matches_after_1000_steps_on_every_preset() {
+fn skjermo_matches_after_240_steps_on_every_preset() {
     let Some(ctx) = common::gpu() else { return };
     let wind = WindScene::resolve("gusty").unwrap();
     let fw = wind.packed();
@@ -23,7 +24,7 @@ fn skjermo_matches_after_1000_steps_on_every_preset() {
         let m = Skjermo::new(&t, SkjermoParams::default());
         let mut cpu = m.rest_state(&t);
         let mut gpu = GpuSkjermo::new(ctx, Arc::new(t.clone()), &m, &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
-        for _ in 0..1000 {
+        for _ in 0..240 {
             m.step(&t, &fw, &mut cpu, 1.0 / 60.0);
             gpu.step(ctx, 1.0 / 60.0);
         }
