@@ -244,6 +244,8 @@ fn report(rows: &[Row], methods: &[String], args: &FidelityArgs) -> String {
             frac(&|r| r.flutter[2].map(|f| f >= 0.1)),
         );
     }
-    s += "\nA dash: the run did not ring (fewer than three crossings or peaks above 5 % of the first).\n";
+    s += "\nA dash: the run did not ring down (fewer than three crossings, or fewer than three peaks above \
+          5 % of the largest, or peaks that do not decay as one exponential: fit R² under 0.7). A stateless \
+          method's damping ratio reads the envelope of its noise bands, not a ring-down.\n";
     s
 }
