@@ -11,8 +11,8 @@
 //!    each joint, its moment about the joint — children's forces times their lever arms —
 //!    and the air's damping of turning about it, `Γ = Σ γ r²`.
 //! 3. **Rotation** (`akagi_integrate`): each joint is a spring `k = E·I/ℓ` of its segment's
-//!    section (never thinner than `min_radius`) and length — in a chain, these bend as the beam does under
-//!    the propagated moments. Its inertia is modal, `J = k/ω²` with ω its stem's first-mode
+//!    section (never thinner than `min_radius`) and length — in a chain, these bend as the
+//!    beam does under the propagated moments. Its inertia is modal, `J = k/ω²` with ω its stem's first-mode
 //!    frequency from the wood, sections and carried mass
 //!    ([`crate::physics::stem_frequencies`]), so a stem sways at the tapered cantilever's
 //!    frequency and branches at their own, higher ones. `J θ̈ + (c + Γ) θ̇ + k θ = τ` with
@@ -41,8 +41,8 @@ use glam::Vec3;
 #[serde(default, deny_unknown_fields)]
 pub struct AkagiParams {
     /// Structural damping ratio ζ of every joint (≤ 0.9). Default
-    /// [`crate::physics::STRUCTURAL_DAMPING`]; the air adds its own through the relative
-    /// velocity, rising with the wind.
+    /// [`crate::physics::STRUCTURAL_DAMPING`]; the air adds its own damping Γ, which rises
+    /// with the wind.
     pub damping_ratio: f32,
     /// Drag coefficient of bark (a cylinder in cross-flow ≈ 1.0–1.2).
     pub drag: f32,
