@@ -41,6 +41,9 @@ pub struct SkjermoRow {
     pub cpu_bytes_per_update: usize,
     /// CPU fast path, updates/s.
     pub cpu: Option<Rate>,
+    /// CPU fast path with the published form (the bend following the wind at once, no
+    /// reconfiguration), updates/s: what the second-order bend costs.
+    pub cpu_published: Option<Rate>,
     /// CPU reference kernel, updates/s.
     pub cpu_reference: Option<Rate>,
     /// GPU, updates/s.
@@ -75,11 +78,20 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         // state written.
         let bytes = n * (std::mem::size_of::<RawSkjermoStem>() + 3 * std::mem::size_of::<RawSkjermoState>());
         let cpu_bytes = m.lanes.len() * (std::mem::size_of::<StemLanes>() + 3 * std::mem::size_of::<StateLanes>());
-        let (cpu, cpu_reference) = if env.time_cpu {
+        let (cpu, cpu_published, cpu_reference) = if env.time_cpu {
             let mut state = m.rest_state(&tree);
             let fast = measure(env.budget, |k| {
                 for _ in 0..k {
                     m.step_stems(&fields, &waves, &mut state, dt);
+                }
+                Ok(())
+            })?;
+            let published =
+                Skjermo::new(&tree, SkjermoParams { dynamics: false, vogel_exponent: 0.0, ..SkjermoParams::default() });
+            let mut state = published.rest_state(&tree);
+            let published = measure(env.budget, |k| {
+                for _ in 0..k {
+                    published.step_stems(&fields, &waves, &mut state, dt);
                 }
                 Ok(())
             })?;
@@ -90,9 +102,9 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                 }
                 Ok(())
             })?;
-            (Some(fast), Some(reference))
+            (Some(fast), Some(published), Some(reference))
         } else {
-            (None, None)
+            (None, None, None)
         };
         let gpu = match env.ctx {
             Some(c) => {
@@ -120,6 +132,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             cpu_bandwidth_fraction: cpu.map(|r| r.median * cpu_bytes as f64 / env.machine.cpu_bandwidth),
             gpu_bandwidth_fraction: gpu.zip(env.machine.gpu_bandwidth).map(|(r, b)| r.median * bytes as f64 / b),
             cpu,
+            cpu_published,
             cpu_reference,
             gpu,
         };
@@ -143,12 +156,14 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         "Updates per second, median (slowest–fastest). Wind: four sines (the paper's setting). The paper: \
          GeForce 7900 GTX, the wind animation shader alone. MB/update: stem constants and state read, state \
          written; the CPU fast path's lane groups hold {} bytes of constants per stem, the GPU's (and the \
-         reference kernel's) records {}. Over 100 % of bandwidth: part of the working set stays in cache.\n\n",
+         reference kernel's) records {}. Over 100 % of bandwidth: part of the working set stays in cache. \
+         Published form: the fast path with eq. 16 as printed (the bend follows the wind at once, no \
+         reconfiguration), against the default second-order bend.\n\n",
         std::mem::size_of::<StemLanes>() / sylva_core::methods::skjermo::lanes::LANES,
         std::mem::size_of::<RawSkjermoStem>()
     );
-    md += "| paper branches | paper updates/s | branches | MB/update (CPU / GPU) | CPU updates/s | CPU reference kernel | CPU / paper | CPU % of bandwidth | GPU updates/s | GPU / paper | GPU % of bandwidth | GPU / CPU |\n";
-    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    md += "| paper branches | paper updates/s | branches | MB/update (CPU / GPU) | CPU updates/s | CPU, published form | CPU / published | CPU reference kernel | CPU / paper | CPU % of bandwidth | GPU updates/s | GPU / paper | GPU % of bandwidth | GPU / CPU |\n";
+    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let over = |r: Option<Rate>, p: Option<f64>| match (r, p) {
         (Some(r), Some(p)) => format!("{:.2}", r.median / p),
         _ => "–".into(),
@@ -156,13 +171,15 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     let pct = |f: Option<f64>| f.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f));
     for r in &out {
         md += &format!(
-            "| {} | {} | {} | {:.1} / {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {:.1} / {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.paper_branches.map_or("–".into(), |b| b.to_string()),
             r.paper_updates_per_s.map_or("–".into(), |p| format!("{p:.0}")),
             r.branches,
             r.cpu_bytes_per_update as f64 / 1e6,
             r.bytes_per_update as f64 / 1e6,
             rate(r.cpu),
+            rate(r.cpu_published),
+            over(r.cpu, r.cpu_published.map(|p| p.median)),
             rate(r.cpu_reference),
             over(r.cpu, r.paper_updates_per_s),
             pct(r.cpu_bandwidth_fraction),

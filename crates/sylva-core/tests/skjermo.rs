@@ -195,14 +195,14 @@ fn the_lane_path_matches_the_reference_kernel() {
 /// a CPU without AVX2 only the baseline runs, and the test says so.
 #[test]
 fn every_instruction_set_level_gives_the_same_bits() {
-    use sylva_core::methods::skjermo::lanes::{StateLanes, step};
+    use sylva_core::methods::skjermo::lanes::{StateLanes, coefficients, step};
     use sylva_core::simd::{Level, detected};
     if detected() == Level::Baseline {
         println!("this CPU has no AVX2: only the baseline level runs");
     }
     let bits = |s: &[StateLanes]| -> Vec<u32> {
         s.iter()
-            .flat_map(|g| g.delta.iter().chain([&g.orient]).flat_map(|v| [v.x, v.y, v.z]))
+            .flat_map(|g| g.delta.iter().chain([&g.orient, &g.bend, &g.rate]).flat_map(|v| [v.x, v.y, v.z]))
             .flat_map(|v| v.to_array().map(f32::to_bits))
             .collect()
     };
@@ -214,8 +214,10 @@ fn every_instruction_set_level_gives_the_same_bits() {
             let run = |level: Level| {
                 let mut s = m.rest_state(&t).lanes;
                 let mut next = s.clone();
+                let cs = coefficients(&m.lanes, 1.0 / 60.0);
                 for k in 1..=200 {
-                    step(level, &fw.fields, &fw.waves, &m.lanes, &s, m.lane_step(k as f32 / 60.0), &mut next);
+                    let at = m.lane_step(k as f32 / 60.0, 1.0 / 60.0);
+                    step(level, &fw.fields, &fw.waves, &m.lanes, &cs, &s, at, &mut next);
                     std::mem::swap(&mut s, &mut next);
                 }
                 bits(&s)
@@ -232,7 +234,7 @@ fn every_instruction_set_level_gives_the_same_bits() {
 /// no out-of-bounds read, and the same bits as the same group with `NONE` parents.
 #[test]
 fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
-    use sylva_core::methods::skjermo::lanes::{StateLanes, step};
+    use sylva_core::methods::skjermo::lanes::{StateLanes, coefficients, step};
     use sylva_core::model::NONE;
     use sylva_core::simd::{Level, detected};
     let t = tree("quaking_aspen");
@@ -250,15 +252,16 @@ fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
     }
     let bits = |s: &[StateLanes]| -> Vec<u32> {
         s.iter()
-            .flat_map(|g| g.delta.iter().chain([&g.orient]).flat_map(|v| [v.x, v.y, v.z]))
+            .flat_map(|g| g.delta.iter().chain([&g.orient, &g.bend, &g.rate]).flat_map(|v| [v.x, v.y, v.z]))
             .flat_map(|v| v.to_array().map(f32::to_bits))
             .collect()
     };
     let run = |lanes: &[_], level: Level| {
         let mut s = m.rest_state(&t).lanes;
         let mut next = s.clone();
+        let cs = coefficients(lanes, 1.0 / 60.0);
         for k in 1..=20 {
-            step(level, &fw.fields, &fw.waves, lanes, &s, m.lane_step(k as f32 / 60.0), &mut next);
+            step(level, &fw.fields, &fw.waves, lanes, &cs, &s, m.lane_step(k as f32 / 60.0, 1.0 / 60.0), &mut next);
             std::mem::swap(&mut s, &mut next);
         }
         bits(&s)

@@ -16,6 +16,8 @@ pub const TREE: &str = include_str!("wgsl/tree.wgsl");
 pub const NOISE: &str = include_str!("wgsl/noise.wgsl");
 /// Wind fields: `Field`, `Wave`, `wind_at(p, t)`; binds the scene at bindings 0 and 1.
 pub const WIND: &str = include_str!("wgsl/wind.wgsl");
+/// The exact damped-oscillator step (`damped_coefficients`, `damped_apply`).
+pub const OSCILLATOR: &str = include_str!("wgsl/oscillator.wgsl");
 
 /// Kernel: wind velocity at many (x, t) samples.
 pub const WIND_SAMPLE: &str = include_str!("wind/wind_sample.wgsl");
@@ -108,8 +110,8 @@ kernels! {
     zioma_rotations: [QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS] => sylva_core::methods::zioma::rotations::zioma_rotations;
     akagi_forces: [QUAT, TREE, NOISE, WIND, AKAGI, AKAGI_FORCES] => sylva_core::methods::akagi::kernels::akagi_forces;
     akagi_subtree: [AKAGI_SUBTREE] => sylva_core::methods::akagi::kernels::akagi_subtree;
-    akagi_integrate: [QUAT, TREE, AKAGI, AKAGI_INTEGRATE] => sylva_core::methods::akagi::kernels::akagi_integrate;
-    skjermo_step: [QUAT, TREE, NOISE, WIND, SKJERMO, SKJERMO_STEP] => sylva_core::methods::skjermo::kernels::skjermo_step;
+    akagi_integrate: [QUAT, TREE, OSCILLATOR, AKAGI, AKAGI_INTEGRATE] => sylva_core::methods::akagi::kernels::akagi_integrate;
+    skjermo_step: [QUAT, TREE, NOISE, WIND, OSCILLATOR, SKJERMO, SKJERMO_STEP] => sylva_core::methods::skjermo::kernels::skjermo_step;
     skjermo_rotations: [QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS] => sylva_core::methods::skjermo::kernels::skjermo_rotations;
     skjermo_rest_orient: [QUAT, TREE, SKJERMO, SKJERMO_REST_ORIENT] => sylva_core::methods::skjermo::kernels::skjermo_rest_orient;
     hsm_clusters: [QUAT, NOISE, WIND, HSM, HSM_CLUSTERS] => sylva_core::methods::hsm::kernels::hsm_clusters;

@@ -208,7 +208,9 @@ fn wind_and_noise_structs_match_their_wgsl_twins() {
 #[test]
 fn animation_structs_match_their_wgsl_twins() {
     use sylva_core::methods::akagi::{RawAkagiSegment, RawAkagiStep};
-    use sylva_core::methods::skjermo::{RawSkjermoState, RawSkjermoStem, RawSkjermoStep};
+    use sylva_core::methods::skjermo::{
+        RawSkjermoMode, RawSkjermoState, RawSkjermoStem, RawSkjermoStep, RawSkjermoSway,
+    };
     use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaStem};
     use sylva_gpu::shaders::{AKAGI, NOISE, QUAT, SKJERMO, TREE, WIND, ZIOMA_ROTATIONS};
     let zioma = compose(&[QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS]);
@@ -305,8 +307,28 @@ fn animation_structs_match_their_wgsl_twins() {
             ("exponent", offset_of!(RawSkjermoStep, exponent)),
             ("p2_weight", offset_of!(RawSkjermoStep, p2_weight)),
             ("max_bend", offset_of!(RawSkjermoStep, max_bend)),
-            ("_pad", offset_of!(RawSkjermoStep, _pad)),
+            ("dt", offset_of!(RawSkjermoStep, dt)),
+            ("dynamics", offset_of!(RawSkjermoStep, dynamics)),
+            ("reconfiguration_speed", offset_of!(RawSkjermoStep, reconfiguration_speed)),
+            ("vogel_exponent", offset_of!(RawSkjermoStep, vogel_exponent)),
         ],
+    );
+    check_in(
+        &skjermo,
+        "SkjermoMode",
+        size_of::<RawSkjermoMode>(),
+        &[
+            ("w2", offset_of!(RawSkjermoMode, w2)),
+            ("damping", offset_of!(RawSkjermoMode, damping)),
+            ("aero", offset_of!(RawSkjermoMode, aero)),
+            ("_pad", offset_of!(RawSkjermoMode, _pad)),
+        ],
+    );
+    check_in(
+        &skjermo,
+        "SkjermoSway",
+        size_of::<RawSkjermoSway>(),
+        &[("bend", offset_of!(RawSkjermoSway, bend)), ("rate", offset_of!(RawSkjermoSway, rate))],
     );
 }
 

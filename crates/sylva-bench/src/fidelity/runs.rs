@@ -78,13 +78,15 @@ pub struct Row {
     pub flutter: [Option<f32>; 3],
 }
 
-/// A Weber–Penn species with its size (`scale`) times `factor`.
+/// A Weber–Penn species grown `factor` times as large, geometrically similar: its size
+/// (`scale`) and its leaves' (`leaf_scale`).
 pub fn grow(species: &str, factor: f64) -> Result<Arc<Tree>> {
     let SpeciesSource::WeberPenn { file, mut params } = SpeciesSource::resolve(species)? else {
         bail!("--species {species}: a size series needs a Weber–Penn species (a grammar has no `scale`)");
     };
     params.scale *= factor;
     params.scale_v *= factor;
+    params.leaf_scale *= factor;
     let tree = SpeciesSource::WeberPenn { file, params }
         .generate(1, &Default::default(), None)
         .with_context(|| format!("growing {species} ×{factor}"))?;

@@ -1,18 +1,21 @@
-//! Each stem's first bending mode: the natural frequency of a tapered cantilever from the
-//! wood (E, density), its sections and the mass it carries (its own wood and leaves, and
-//! every stem growing from it, lumped where it attaches).
+//! Each stem's first bending mode and static bend, as a continuous tapered cantilever: the
+//! natural frequency from the wood (E, density), its sections and the mass it carries (its
+//! own wood and leaves, and every stem growing from it, lumped where it starts), and the
+//! tip's deflection under the drag on all of that ([`tip_deflections`]).
 //!
-//! The frequency is Rayleigh's quotient with the static deflection under the stem's own
-//! weight as the mode shape (the "static deflection method"; for a uniform cantilever it
-//! gives 3.53 √(EI/ρA)/L² against the exact 1.875² = 3.516, 0.4 % high):
+//! The beam is integrated in [`PIECES`] pieces per segment, each with the section at its
+//! middle (radii tapering from the segment's base to its tip, never under the minimum
+//! radius): the moment from every load beyond a point, curvature `M / E I`, slope and
+//! deflection. The frequency is Rayleigh's quotient with the static deflection under the
+//! stem's own weight as the mode shape (the "static deflection method"; for a uniform
+//! cantilever it gives 3.53 √(EI/ρA)/L² against the exact 1.875² = 3.516, 0.4 % high):
 //! `ω² = Σ m y / Σ m y²` over the stem's masses, with `y` the deflection under loads equal
-//! to those masses. The stem bends at its joints, each a spring `k = E I / ℓ` of its
-//! segment's length ℓ and mechanical radius ([`super::mechanical_radii`]) — a chain of such
-//! springs bends as the continuous beam does under the same moments — and each segment
-//! turns rigidly between joints, so its own mass enters `Σ m y²` as a rod's,
-//! `m (y_c² + (φ ℓ)²/12)`.
+//! to those masses.
 
 use crate::model::Tree;
+
+/// Pieces each segment is integrated in.
+pub const PIECES: usize = 8;
 
 /// Per-stem natural frequencies of one tree.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,73 +44,180 @@ pub fn segment_masses(tree: &Tree) -> Vec<f32> {
     m
 }
 
-/// The first bending mode of every stem of `tree`, with joints never thinner than
-/// `min_radius` (m). Stems with no mass or no compliance get 0 rad/s.
-pub fn stem_frequencies(tree: &Tree, min_radius: f32) -> StemModes {
-    stem_frequencies_with(tree, &super::bending_radii(tree, min_radius))
+/// Drag area `C_d A` of each segment, m²: its bark (`(r_base + r_tip) ℓ`) with `bark_drag`
+/// and its leaf blades (π/4 · w · l) with `leaf_drag`, both times `shelter` except the
+/// trunk's bark ([`super::crown_shelter`]).
+pub fn drag_areas(tree: &Tree, bark_drag: f32, leaf_drag: f32, shelter: f32) -> Vec<f32> {
+    let s = &tree.segments;
+    let mut a: Vec<f32> = (0..s.len())
+        .map(|i| {
+            let crown = if tree.stems.level[s.stem[i] as usize] == 0 { 1.0 } else { shelter };
+            crown * bark_drag * (s.radius_base[i] + s.radius_tip[i]) * s.length[i]
+        })
+        .collect();
+    for (k, &seg) in tree.leaves.segment.iter().enumerate() {
+        a[seg as usize] +=
+            shelter * leaf_drag * std::f32::consts::FRAC_PI_4 * tree.leaves.width[k] * tree.leaves.length[k];
+    }
+    a
 }
 
-/// [`stem_frequencies`] with each joint's bending radius given (m).
-pub fn stem_frequencies_with(tree: &Tree, r_mech: &[f32]) -> StemModes {
-    let s = &tree.segments;
-    let st = &tree.stems;
-    let n = s.len();
+/// How each stem bends under the wind's drag.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DragBend {
+    /// Static tip deflection per pascal of dynamic pressure `½ ρ u²`, m/Pa (tree order).
+    pub tip: Vec<f32>,
+    /// Where the drag acts, as a fraction of the tip's motion: the drag-weighted mean of
+    /// the deflection shape, `Σ F y / (Σ F · y_tip)` (0.4 for a uniform load on a uniform
+    /// cantilever; more where the load sits near the tip, as a crown does).
+    pub pressure_centre: Vec<f32>,
+}
+
+/// Each stem's static bend under the drag of the stem and of everything growing from it
+/// (`cd_area`: each segment's `C_d A`, [`drag_areas`]): each segment's own drag spread along
+/// it, every side stem's whole subtree where it starts; sections never thinner than
+/// `min_radius` (m).
+pub fn drag_bend(tree: &Tree, min_radius: f32, cd_area: &[f32]) -> DragBend {
+    let subtree = subtree_sums(tree, cd_area);
+    let mut beam = Beam::default();
+    let (mut tip, mut pressure_centre) = (Vec::new(), Vec::new());
+    for k in 0..tree.stems.len() {
+        beam.bend(tree, k, cd_area, &subtree, min_radius);
+        let y_tip = beam.tip();
+        let (mut force, mut work) = (0.0f64, 0.0f64);
+        for &(f, y) in &beam.loads {
+            force += f;
+            work += f * y;
+        }
+        tip.push(y_tip as f32);
+        pressure_centre.push(if force > 0.0 && y_tip > 0.0 { (work / (force * y_tip)) as f32 } else { 0.4 });
+    }
+    DragBend { tip, pressure_centre }
+}
+
+/// The first bending mode of every stem of `tree`, with sections never thinner than
+/// `min_radius` (m). Stems with no mass or no compliance get 0 rad/s.
+pub fn stem_frequencies(tree: &Tree, min_radius: f32) -> StemModes {
     let own = segment_masses(tree);
-    let mut subtree_mass = own.clone();
-    for i in (0..n).rev() {
-        let carried: f32 = tree.children.of(i).iter().map(|&c| subtree_mass[c as usize]).sum();
-        subtree_mass[i] += carried;
-    }
-    let mut omega = vec![0.0f32; st.len()];
-    // Per segment of a stem: own mass at the centre, child stems lumped at the end.
-    let mut lumped = Vec::new();
-    let mut compliance = Vec::new();
-    let mut moment = Vec::new();
-    for (k, w) in omega.iter_mut().enumerate() {
-        let first = st.first_segment[k] as usize;
-        let count = st.segment_count[k] as usize;
-        if count == 0 {
-            continue;
-        }
-        let range = first..first + count;
-        lumped.clear();
-        compliance.clear();
-        for i in range.clone() {
-            let side: f32 = tree
-                .children
-                .of(i)
-                .iter()
-                .filter(|&&c| s.stem[c as usize] as usize != k)
-                .map(|&c| subtree_mass[c as usize])
-                .sum();
-            lumped.push(side as f64);
-            let stiff = tree.wood.segment_stiffness(s.length[i], r_mech[i]) as f64;
-            compliance.push(if stiff > 0.0 { 1.0 / stiff } else { 0.0 });
-        }
-        // Bending moment at each joint under loads equal to the masses (g = 1), tip first.
-        moment.clear();
-        moment.resize(count, 0.0f64);
-        let (mut beyond, mut m_next) = (0.0f64, 0.0f64);
-        for j in (0..count).rev() {
-            let (l, m) = (s.length[first + j] as f64, own[first + j] as f64);
-            moment[j] = m_next + (beyond + lumped[j]) * l + m * 0.5 * l;
-            beyond += lumped[j] + m;
-            m_next = moment[j];
-        }
-        // Slope and deflection from the base; Rayleigh's sums.
-        let (mut slope, mut y, mut work, mut kinetic) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-        for j in 0..count {
-            let (l, m) = (s.length[first + j] as f64, own[first + j] as f64);
-            slope += moment[j] * compliance[j];
-            let yc = y + slope * 0.5 * l;
-            let ye = y + slope * l;
-            work += m * yc + lumped[j] * ye;
-            kinetic += m * (yc * yc + slope * slope * l * l / 12.0) + lumped[j] * ye * ye;
-            y = ye;
-        }
-        if kinetic > 0.0 && work > 0.0 {
-            *w = (work / kinetic).sqrt() as f32;
-        }
-    }
+    let subtree_mass = subtree_sums(tree, &own);
+    let mut beam = Beam::default();
+    let omega = (0..tree.stems.len())
+        .map(|k| {
+            // Loads equal to the masses (g = 1); Rayleigh's sums over the deflections.
+            beam.bend(tree, k, &own, &subtree_mass, min_radius);
+            let (mut work, mut kinetic) = (0.0f64, 0.0f64);
+            for &(m, y) in &beam.loads {
+                work += m * y;
+                kinetic += m * y * y;
+            }
+            if kinetic > 0.0 && work > 0.0 { (work / kinetic).sqrt() as f32 } else { 0.0 }
+        })
+        .collect();
     StemModes { omega, subtree_mass }
+}
+
+/// Each segment's value summed with everything beyond it.
+fn subtree_sums(tree: &Tree, own: &[f32]) -> Vec<f32> {
+    let mut sum = own.to_vec();
+    for i in (0..sum.len()).rev() {
+        let carried: f32 = tree.children.of(i).iter().map(|&c| sum[c as usize]).sum();
+        sum[i] += carried;
+    }
+    sum
+}
+
+/// One piece of a stem: where it starts along the stem, its length and flexural rigidity,
+/// and (after bending) its curvature, and the slope and deflection at its start.
+#[derive(Debug, Clone, Copy, Default)]
+struct Piece {
+    x: f64,
+    h: f64,
+    ei: f64,
+    curvature: f64,
+    slope: f64,
+    y: f64,
+}
+
+impl Piece {
+    /// Deflection `o` along the piece (constant curvature within it).
+    fn y_at(&self, o: f64) -> f64 {
+        self.y + self.slope * o + 0.5 * self.curvature * o * o
+    }
+}
+
+/// A stem bent as a continuous tapered cantilever under lateral point loads.
+#[derive(Debug, Default)]
+struct Beam {
+    pieces: Vec<Piece>,
+    /// Each load's piece, offset within it (m) and size.
+    at: Vec<(usize, f64, f64)>,
+    /// Each load's size and deflection, after [`Beam::bend`].
+    loads: Vec<(f64, f64)>,
+    events: Vec<(f64, usize)>,
+}
+
+impl Beam {
+    /// Bends stem `k` under `own[i]` spread along each of its segments and `subtree[c]` where
+    /// each side stem starts (unit loads give deflections per load).
+    fn bend(&mut self, tree: &Tree, k: usize, own: &[f32], subtree: &[f32], min_radius: f32) {
+        let s = &tree.segments;
+        let first = tree.stems.first_segment[k] as usize;
+        let count = tree.stems.segment_count[k] as usize;
+        self.pieces.clear();
+        self.at.clear();
+        let mut x = 0.0f64;
+        for (i, &load) in own.iter().enumerate().skip(first).take(count) {
+            let l = s.length[i] as f64;
+            let h = l / PIECES as f64;
+            let base = self.pieces.len();
+            for p in 0..PIECES {
+                let t = (p as f32 + 0.5) / PIECES as f32;
+                let r = (s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * t).max(min_radius) as f64;
+                let ei = tree.wood.young_modulus as f64 * std::f64::consts::FRAC_PI_4 * r.powi(4);
+                self.pieces.push(Piece { x: x + p as f64 * h, h, ei, ..Default::default() });
+                self.at.push((base + p, 0.5 * h, load as f64 / PIECES as f64));
+            }
+            for &c in tree.children.of(i) {
+                let c = c as usize;
+                if s.stem[c] as usize != k {
+                    let along = ((s.start[c] - s.start[i]).dot(s.axis(i)) as f64).clamp(0.0, l);
+                    let p = ((along / h) as usize).min(PIECES - 1);
+                    self.at.push((base + p, along - p as f64 * h, subtree[c] as f64));
+                }
+            }
+            x += l;
+        }
+        // Moments at the pieces' middles: sweep from the tip down over loads and middles,
+        // carrying the force beyond and its moment.
+        self.events.clear();
+        self.events.extend(self.at.iter().enumerate().map(|(n, &(p, o, _))| (self.pieces[p].x + o, n)));
+        self.events.extend(self.pieces.iter().enumerate().map(|(p, q)| (q.x + 0.5 * q.h, usize::MAX - p)));
+        self.events.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let (mut force, mut moment, mut here) = (0.0f64, 0.0f64, x);
+        for &(pos, e) in &self.events {
+            moment += force * (here - pos);
+            here = pos;
+            if e >= self.at.len() {
+                let q = &mut self.pieces[usize::MAX - e];
+                q.curvature = if q.ei > 0.0 { moment / q.ei } else { 0.0 };
+            } else {
+                force += self.at[e].2;
+            }
+        }
+        // Slopes and deflections from the base.
+        let (mut slope, mut y) = (0.0f64, 0.0f64);
+        for q in &mut self.pieces {
+            q.slope = slope;
+            q.y = y;
+            y += slope * q.h + 0.5 * q.curvature * q.h * q.h;
+            slope += q.curvature * q.h;
+        }
+        self.loads.clear();
+        self.loads.extend(self.at.iter().map(|&(p, o, f)| (f, self.pieces[p].y_at(o))));
+    }
+
+    /// Deflection of the stem's tip.
+    fn tip(&self) -> f64 {
+        self.pieces.last().map_or(0.0, |q| q.y_at(q.h))
+    }
 }

@@ -6,6 +6,7 @@
 pub mod beam;
 pub mod drag;
 pub mod measure;
+pub mod oscillator;
 
 pub use beam::{StemModes, stem_frequencies};
 pub use drag::{DragModel, STRUCTURAL_DAMPING};
@@ -22,6 +23,46 @@ pub const MIN_RADIUS: f32 = 0.0015;
 /// Drag coefficient of bark and leaves together (a cylinder in cross-flow ≈ 1.0–1.2;
 /// leaves streamline in wind, lowering it).
 pub const BRANCH_DRAG: f32 = 0.8;
+
+/// Effective drag coefficient per unit (one-sided) leaf area. 0.03: leaves in a crown
+/// shelter one another, so the sum over leaves must come to a crown's drag (C_d ≈ 0.2–0.3 on
+/// the crown's frontal area, which for a broadleaf crown is 5–10 times smaller than its leaf
+/// area).
+pub const LEAF_DRAG: f32 = 0.03;
+
+/// Drag coefficient of a whole crown on its frontal area (0.25: crowns measured in wind
+/// tunnels give 0.2–0.3 at moderate speeds before they streamline, Mayhead 1973; Vollsinger
+/// et al. 2005).
+pub const CROWN_DRAG: f32 = 0.25;
+
+/// How much the crown of `tree` shelters itself, 0–1: the factor on the drag of its leaves
+/// (`leaf_drag` per unit area) and of the bark of every stem but the trunk (`bark_drag`) so
+/// that together they drag no more than the crown would as a body, [`CROWN_DRAG`] on its
+/// frontal area (in a dense crown, leaves and twigs sit in one another's wake). The frontal
+/// area is the ellipse spanned by the leaves' height and horizontal spread; a tree without
+/// leaves is not sheltered.
+pub fn crown_shelter(tree: &Tree, bark_drag: f32, leaf_drag: f32) -> f32 {
+    let l = &tree.leaves;
+    if l.is_empty() {
+        return 1.0;
+    }
+    let (mut lo, mut hi) = (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN));
+    let mut drag = 0.0f32;
+    for k in 0..l.len() {
+        lo = lo.min(l.position[k]);
+        hi = hi.max(l.position[k]);
+        drag += leaf_drag * std::f32::consts::FRAC_PI_4 * l.width[k] * l.length[k];
+    }
+    let s = &tree.segments;
+    for i in 0..s.len() {
+        if tree.stems.level[s.stem[i] as usize] > 0 {
+            drag += bark_drag * (s.radius_base[i] + s.radius_tip[i]) * s.length[i];
+        }
+    }
+    let size = hi - lo;
+    let frontal = std::f32::consts::FRAC_PI_4 * size.y * 0.5 * (size.x + size.z);
+    if drag > 0.0 { (CROWN_DRAG * frontal / drag).clamp(0.0, 1.0) } else { 1.0 }
+}
 
 /// Mechanical radius of each segment, m: its own base radius, but never thinner than
 /// `min_radius` nor than the radius whose section equals its children's together

@@ -134,6 +134,32 @@ pub fn powi(mut x: V, mut k: u32) -> V {
     r
 }
 
+/// `x^e` on sixteen lanes for finite `x ≥ 1`, as `2^(e log₂ x)` with polynomials (the
+/// logarithm by `atanh` of the mantissa, the power of two by its Taylor series on
+/// [−½, ½] and the exponent's bits): relative error under `1e-7 · (1 + |e log₂ x|)` (the
+/// rounding of the exponent `e log₂ x` to `f32` dominates) while `|e log₂ x| < 126`, where
+/// `f32::powf` costs a library call per lane.
+#[inline(always)]
+pub fn pow_ge1(x: V, e: f32) -> V {
+    let mut r = [0.0f32; LANES];
+    for (r, &a) in r.iter_mut().zip(x.as_array_ref()) {
+        let bits = a.to_bits();
+        let exponent = ((bits >> 23) as i32 - 127) as f32;
+        let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
+        // ln m = 2 atanh(t), t = (m − 1)/(m + 1) in [0, 1/3).
+        let t = (m - 1.0) / (m + 1.0);
+        let t2 = t * t;
+        let p = ((((t2 * (1.0 / 11.0) + 1.0 / 9.0) * t2 + 1.0 / 7.0) * t2 + 0.2) * t2 + 1.0 / 3.0) * t2 + 1.0;
+        let y = (e * (exponent + 2.0 * std::f32::consts::LOG2_E * t * p)).clamp(-126.0, 126.0);
+        let n = (y + 0.5).floor();
+        let f = (y - n) * std::f32::consts::LN_2;
+        let q =
+            (((((f * (1.0 / 720.0) + 1.0 / 120.0) * f + 1.0 / 24.0) * f + 1.0 / 6.0) * f + 0.5) * f + 1.0) * f + 1.0;
+        *r = q * f32::from_bits(((n as i32 + 127) as u32) << 23);
+    }
+    V::from(r)
+}
+
 /// The wind scene at sixteen points (as `wind::sample::wind_at`).
 #[inline(always)]
 pub fn wind_lanes(fields: &[RawField], waves: &[RawWave], p: V3, t: f32) -> V3 {
@@ -216,6 +242,23 @@ mod tests {
                 assert!((got - w).length() <= 1e-6 * (1.0 + w.length()), "{v} · {len}: {got} vs {w}");
             } else {
                 assert!(got.length() <= len * (1.0 + 1e-6), "{v} · {len}: {got}");
+            }
+        }
+    }
+
+    #[test]
+    fn pow_ge1_matches_powf() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        for _ in 0..2000 {
+            let x: [f32; LANES] = std::array::from_fn(|_| 1.0 + rng.random::<f32>().powi(3) * 1e4);
+            let e = -2.0 * rng.random::<f32>();
+            let got = pow_ge1(V::from(x), e);
+            for (l, &a) in x.iter().enumerate() {
+                let want = a.powf(e);
+                let g = got.as_array_ref()[l];
+                let tol = 1e-7 * (1.0 + (e * a.log2()).abs());
+                assert!((g / want - 1.0).abs() < tol, "{a}^{e}: {g} vs {want}");
             }
         }
     }

@@ -4,6 +4,7 @@
 use crate::methods::akagi::{RawAkagiSegment, RawAkagiStep};
 use crate::model::RawSegment;
 use crate::physics::DragModel;
+use crate::physics::oscillator::damped_step;
 use crate::wind::raw::{RawField, RawWave};
 use crate::wind::sample::wind_at;
 use glam::{Quat, Vec3};
@@ -165,26 +166,4 @@ pub fn stiffening(b: f32, theta_s: f32) -> f32 {
     // θ / θ_s.
     let u = 2.0 / 3f32.sqrt() * ((3.0 * 3f32.sqrt() * b / (2.0 * theta_s)).asinh() / 3.0).sinh();
     1.0 + u * u
-}
-
-/// The exact step of `x¨ + 2 a x˙ + w² (x − x_eq) = 0` over `dt` from `(x0, v0)`:
-/// `(x1, v1)`, under- or overdamped. WGSL: the same lines in `akagi_integrate.wgsl`.
-#[inline]
-pub fn damped_step(x0: Vec3, v0: Vec3, x_eq: Vec3, w2: f32, a: f32, dt: f32) -> (Vec3, Vec3) {
-    // x(t) = C x0' + S (v0 + a x0'), v(t) = C v0 − S (a v0 + w² x0'), x0' = x0 − x_eq, with
-    // C = e^(−at) cos(ω_d t), S = e^(−at) sin(ω_d t) / ω_d (cosh and sinh when overdamped,
-    // written with exponentials that cannot overflow).
-    let disc = w2 - a * a;
-    let (c, s) = if disc > 0.0 {
-        let wd = disc.sqrt();
-        let e = (-a * dt).exp();
-        let (sn, cs) = (wd * dt).sin_cos();
-        (e * cs, e * sn / wd)
-    } else {
-        let b = (-disc).sqrt();
-        let (e1, e2) = (((b - a) * dt).exp(), (-(a + b) * dt).exp());
-        (0.5 * (e1 + e2), if b > 1e-6 { 0.5 * (e1 - e2) / b } else { e1 * dt })
-    };
-    let x = x0 - x_eq;
-    (x_eq + x * c + (v0 + x * a) * s, v0 * c - (v0 * a + x * w2) * s)
 }

@@ -46,10 +46,9 @@ pub struct AkagiParams {
     pub damping_ratio: f32,
     /// Drag coefficient of bark (a cylinder in cross-flow ≈ 1.0–1.2).
     pub drag: f32,
-    /// Effective drag coefficient per unit (one-sided) leaf area. Default 0.03: leaves in a
-    /// crown shelter one another, so the sum over leaves must come to a crown's drag
-    /// (C_d ≈ 0.2–0.3 on the crown's frontal area, which for a broadleaf crown is 5–10 times
-    /// smaller than its leaf area).
+    /// Effective drag coefficient per unit (one-sided) leaf area
+    /// ([`crate::physics::LEAF_DRAG`]; leaves and twigs of a crown so dense that they would
+    /// drag more than the crown as a body are sheltered, [`crate::physics::crown_shelter`]).
     pub leaf_drag: f32,
     /// Substeps per `step` call.
     pub substeps: u32,
@@ -74,7 +73,7 @@ impl Default for AkagiParams {
         Self {
             damping_ratio: crate::physics::STRUCTURAL_DAMPING,
             drag: 0.8,
-            leaf_drag: 0.03,
+            leaf_drag: crate::physics::LEAF_DRAG,
             substeps: 1,
             min_radius: crate::physics::MIN_RADIUS,
             reconfiguration_speed: 5.0,
@@ -151,7 +150,8 @@ impl Akagi {
             leaf_area[seg as usize] += std::f32::consts::FRAC_PI_4 * tree.leaves.width[k] * tree.leaves.length[k];
         }
         let r_mech = crate::physics::bending_radii(tree, params.min_radius);
-        let modes = crate::physics::beam::stem_frequencies_with(tree, &r_mech);
+        let modes = crate::physics::stem_frequencies(tree, params.min_radius);
+        let shelter = crate::physics::crown_shelter(tree, params.drag, params.leaf_drag);
         let segments = (0..n)
             .map(|i| {
                 let k = tree.wood.segment_stiffness(s.length[i], r_mech[i]).max(1e-12);
@@ -162,8 +162,10 @@ impl Akagi {
                 }
                 let inertia = (k / (w * w)).max(1e-12);
                 RawAkagiSegment {
-                    bark_area: (s.radius_base[i] + s.radius_tip[i]) * s.length[i],
-                    leaf_area: leaf_area[i] * params.leaf_drag / params.drag.max(1e-6),
+                    bark_area: if tree.stems.level[s.stem[i] as usize] == 0 { 1.0 } else { shelter }
+                        * (s.radius_base[i] + s.radius_tip[i])
+                        * s.length[i],
+                    leaf_area: shelter * leaf_area[i] * params.leaf_drag / params.drag.max(1e-6),
                     inertia,
                     stiffness: k,
                     damping: 2.0 * params.damping_ratio * (k * inertia).sqrt(),

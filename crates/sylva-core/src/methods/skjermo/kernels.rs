@@ -1,8 +1,11 @@
 //! CPU twins of `skjermo_step.wgsl`, `skjermo_rotations.wgsl` and
 //! `skjermo_rest_orient.wgsl` (see [`crate::methods::skjermo`]).
 
-use crate::methods::skjermo::{RawSkjermoState, RawSkjermoStem, RawSkjermoStep, bezier, bezier_d, frame};
+use crate::methods::skjermo::{
+    RawSkjermoMode, RawSkjermoState, RawSkjermoStem, RawSkjermoStep, RawSkjermoSway, bezier, bezier_d, frame,
+};
 use crate::model::NONE;
+use crate::physics::oscillator::{damped_apply, damped_coefficients};
 use crate::wind::raw::{RawField, RawWave};
 use crate::wind::sample::wind_at;
 use glam::{Quat, Vec3};
@@ -13,8 +16,11 @@ fn v3(a: [f32; 4]) -> Vec3 {
     Vec3::new(a[0], a[1], a[2])
 }
 
-/// One step for every stem, reading the previous state (`prev`) and writing `next`.
-/// Bindings: 0 fields, 1 waves, 2 stems, 3 previous state, 4 step, 5 next state.
+/// One step for every stem, reading the previous state (`prev`) and writing `next`; each
+/// stem's bend oscillator (`sway`) is updated in place.
+/// Bindings: 0 fields, 1 waves, 2 stems, 3 previous state, 4 step, 5 next state, 6 modes,
+/// 7 sway.
+#[allow(clippy::too_many_arguments)]
 pub fn skjermo_step(
     fields: &[RawField],
     waves: &[RawWave],
@@ -22,8 +28,10 @@ pub fn skjermo_step(
     prev: &[RawSkjermoState],
     step: RawSkjermoStep,
     next: &mut [RawSkjermoState],
+    modes: &[RawSkjermoMode],
+    sway: &mut [RawSkjermoSway],
 ) {
-    next.par_iter_mut().enumerate().for_each(|(k, out)| {
+    next.par_iter_mut().zip(sway.par_iter_mut()).enumerate().for_each(|(k, (out, sw))| {
         let st = &stems[k];
         let rest = st.rest.map(v3);
         let (shift, f_now, f_rest) = if st.parent == NONE {
@@ -44,16 +52,31 @@ pub fn skjermo_step(
             let was = f_rest[0] * l.x + f_rest[1] * l.y + f_rest[2] * l.z;
             *dj = shift + (now - was);
         }
-        // Wind at the tip, bend factors (eq. 16), length-keeping update (eq. 17).
+        // Wind at the tip and the static push b₃ = c ŵ (eq. 16), with reconfiguration ...
         let a = [0, 1, 2, 3].map(|j| rest[j] + d[j]);
         let w = wind_at(fields, waves, a[3], step.time);
         let u = w.length();
-        let (mut c2, mut c3) = (Vec3::ZERO, Vec3::ZERO);
-        let theta = (st.drag * u * u).min(step.max_bend);
+        let r = u / step.reconfiguration_speed;
+        let g = (1.0 + r * r).powf(0.5 * step.vogel_exponent);
+        let theta = (st.drag * u * u * g).min(step.max_bend);
         let c = st.length * theta;
-        if u > 0.0 && c > 0.0 {
-            let b3 = w * (c / u);
-            let b2 = w * (c * step.p2_weight.powf(step.exponent) / u);
+        let push = if u > 0.0 && c > 0.0 { w * (c / u) } else { Vec3::ZERO };
+        // ... which the bend follows as the stem's damped first mode (or at once).
+        let b3 = if step.dynamics != 0 {
+            let m = modes[k];
+            let cs = damped_coefficients(m.w2, m.damping, step.dt);
+            let (x, v) = damped_apply(v3(sw.bend), v3(sw.rate), push, m.w2, m.damping, cs);
+            let v = v * (1.0 / (1.0 + m.aero * u * g * step.dt));
+            sw.bend = x.extend(0.0).to_array();
+            sw.rate = v.extend(0.0).to_array();
+            x
+        } else {
+            push
+        };
+        // The length-keeping update (eq. 17).
+        let (mut c2, mut c3) = (Vec3::ZERO, Vec3::ZERO);
+        if b3.length_squared() > 0.0 {
+            let b2 = b3 * step.p2_weight.powf(step.exponent);
             let d2 = a[2] - a[1];
             c2 = (d2 + b2).normalize_or_zero() * d2.length() - d2;
             let p2 = a[2] + c2;

@@ -3,8 +3,9 @@
 //! `kernels::skjermo_step` is the reference (the twin of `skjermo_step.wgsl`, one stem per
 //! invocation). This module computes the same step on groups of sixteen stems held as
 //! structure-of-arrays lanes ([`crate::simd::F32x16`]). At the larger sizes the step is bound
-//! by memory traffic, so a group keeps only what cannot be recomputed cheaply (100 bytes of
-//! constants per stem against the reference's 160) and derives the rest:
+//! by memory traffic, so a group keeps only what cannot be recomputed cheaply (112 bytes of
+//! constants per stem, 12 of them the bend oscillator's, against the reference's 160 + 16)
+//! and derives the rest:
 //!
 //! * the parent's curve enters only through its displacement from rest, because a Bézier is
 //!   linear in its control points: `B(P_rest + Δ, a) = B(P_rest, a) + B(Δ, a)`, so the shift of
@@ -16,7 +17,10 @@
 //!   same instructions that built them;
 //! * the legs P1→P2 and P2→P3 are the local legs turned by the current frame, so of the rest
 //!   control points only the tip (where the wind is sampled) is stored;
-//! * `p2_weight^exponent` is computed once per step, not once per stem;
+//! * `p2_weight^exponent` is computed once per step, not once per stem, and the bend
+//!   oscillators' step coefficients once per step length ([`coefficients`]);
+//! * reconfiguration's power `(1 + (u/U_r)²)^(B/2)` by polynomials ([`pow_ge1`]), not a library
+//!   call per lane;
 //! * the parents' state is fetched with AVX2's gather instruction where the CPU has it.
 //!
 //! The wind is sampled on all sixteen lanes at once ([`crate::wind::lanes`]: a polynomial sine,
@@ -25,10 +29,11 @@
 //! computed by the same instructions whichever thread runs it) and whatever the instruction
 //! set (`simd.rs`: AVX2 where the CPU has it, tested against the baseline).
 
-use super::{RawSkjermoStem, bezier_d};
+use super::{RawSkjermoMode, RawSkjermoStem, bezier_d};
 use crate::model::NONE;
 use crate::simd::{Level, dispatch};
 pub use crate::wind::lanes::LANES;
+pub use crate::wind::lanes::pow_ge1;
 use crate::wind::lanes::{V, V3, wind_lanes};
 use crate::wind::raw::{RawField, RawWave};
 use glam::Vec3;
@@ -81,11 +86,40 @@ pub struct StemLanes {
     pub drag: V,
     /// Arc length, m.
     pub length: V,
+    /// The bend oscillator's ω², rad²/s².
+    pub w2: V,
+    /// Its structural damping rate ζω, 1/s.
+    pub damping: V,
+    /// Its aerodynamic damping per m/s of wind, 1/m.
+    pub aero: V,
 }
 
-/// Per-group state of sixteen stems: control-point displacements and orientation vectors.
-/// In memory fifteen lanes-of-sixteen, component after component (`delta[0].x` … `orient.z`),
-/// which the AVX2 gather relies on.
+/// The bend oscillators' step coefficients `(C, S)` of sixteen stems for one step length
+/// ([`crate::physics::oscillator::damped_coefficients`], per lane).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OscLanes {
+    /// C.
+    pub c: V,
+    /// S.
+    pub s: V,
+}
+
+/// Each group's oscillator coefficients for steps of `dt` seconds.
+pub fn coefficients(stems: &[StemLanes], dt: f32) -> Vec<OscLanes> {
+    stems
+        .iter()
+        .map(|g| {
+            let (w2, a) = (g.w2.as_array_ref(), g.damping.as_array_ref());
+            let cs: [(f32, f32); LANES] =
+                std::array::from_fn(|l| crate::physics::oscillator::damped_coefficients(w2[l], a[l], dt));
+            OscLanes { c: V::from(cs.map(|x| x.0)), s: V::from(cs.map(|x| x.1)) }
+        })
+        .collect()
+}
+
+/// Per-group state of sixteen stems: control-point displacements, orientation vectors and
+/// bend oscillators. In memory twenty-one lanes-of-sixteen, component after component
+/// (`delta[0].x` … `orient.z`, then `bend`, `rate`), which the AVX2 gather relies on.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[repr(C)]
 pub struct StateLanes {
@@ -93,6 +127,10 @@ pub struct StateLanes {
     pub delta: [V3; 4],
     /// Orientation vector O handed to children.
     pub orient: V3,
+    /// The tip's bend vector b₃, m.
+    pub bend: V3,
+    /// Its rate of change, m/s.
+    pub rate: V3,
 }
 
 impl StateLanes {
@@ -108,7 +146,11 @@ impl StateLanes {
 
 /// Builds the lane groups from the reference's per-stem constants; `rest_orient` gives each
 /// stem's rest orientation vector. Returns the groups and the rest state.
-pub fn build(stems: &[RawSkjermoStem], rest_orient: &[[f32; 4]]) -> (Vec<StemLanes>, Vec<StateLanes>) {
+pub fn build(
+    stems: &[RawSkjermoStem],
+    modes: &[RawSkjermoMode],
+    rest_orient: &[[f32; 4]],
+) -> (Vec<StemLanes>, Vec<StateLanes>) {
     let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
     let groups = stems.len().div_ceil(LANES);
     let mut lanes = Vec::with_capacity(groups);
@@ -145,15 +187,18 @@ pub fn build(stems: &[RawSkjermoStem], rest_orient: &[[f32; 4]]) -> (Vec<StemLan
             rest_tip,
             drag: scalar(&|s| s.drag),
             length: scalar(&|s| s.length),
+            w2: V::from(ks.map(|k| k.map_or(0.0, |k| modes[k].w2))),
+            damping: V::from(ks.map(|k| k.map_or(0.0, |k| modes[k].damping))),
+            aero: V::from(ks.map(|k| k.map_or(0.0, |k| modes[k].aero))),
         });
         let orient = V3::from_lanes(ks.map(|k| k.map_or(Vec3::ZERO, |k| v(rest_orient[k]))));
-        state.push(StateLanes { delta: [V3::ZERO; 4], orient });
+        state.push(StateLanes { delta: [V3::ZERO; 4], orient, bend: V3::ZERO, rate: V3::ZERO });
     }
     (lanes, state)
 }
 
 /// Floats in one [`StateLanes`].
-const STATE_FLOATS: usize = 15 * LANES;
+const STATE_FLOATS: usize = 21 * LANES;
 const _: () = assert!(std::mem::size_of::<StateLanes>() == STATE_FLOATS * 4);
 
 /// Gathers the parents' previous state for the sixteen lanes of a group (a trunk or padding
@@ -198,7 +243,7 @@ fn gather_avx2(parent: &[u32; LANES], prev: &[StateLanes]) -> ([V3; 4], V3) {
         // SAFETY: AVX2 is enabled for this function. `parent` holds sixteen u32, read as two
         // unaligned halves of eight. A lane is gathered only where its parent is at most
         // `last`, so its index `(p / 16) · 240 + p % 16 + 16 · component` lies inside `prev`
-        // (`prev` is `repr(C)` fifteen lanes-of-sixteen per group); other lanes keep `c`'s
+        // (`prev` is `repr(C)` twenty-one lanes-of-sixteen per group, of which the first fifteen are read); other lanes keep `c`'s
         // defaults. Stores go to `c`'s arrays, eight floats at offset 0 or 8.
         unsafe {
             let p = _mm256_loadu_si256(parent.as_ptr().add(8 * h).cast());
@@ -237,25 +282,37 @@ fn in_frame(f: &[V3; 3], l: V3) -> V3 {
 pub struct LaneStep {
     /// Time, s.
     pub time: f32,
+    /// Step length, s (the coefficients handed to [`step`] must be for it).
+    pub dt: f32,
+    /// The bend follows the wind as a damped oscillator (else at once).
+    pub dynamics: bool,
     /// `p2_weight^exponent` (eq. 16).
     pub p2_factor: f32,
     /// Largest static bend, rad.
     pub max_bend: f32,
+    /// Reconfiguration speed U_r, m/s.
+    pub reconfiguration_speed: f32,
+    /// Vogel exponent B.
+    pub vogel_exponent: f32,
 }
 
 /// One step for every group: re-attach on the parents' previous curves, sample the wind at
-/// the tips, bend P2 and P3 (eqs. 15–17). Same step as `kernels::skjermo_step`.
+/// the tips, advance the bend oscillators (`coefficients`: [`coefficients`] for `step.dt`),
+/// bend P2 and P3 (eqs. 15–17). Same step as `kernels::skjermo_step`.
 /// `level`: the instruction set to run on, [`crate::simd::level`] for the CPU's best (every
 /// level gives the same bits).
+#[allow(clippy::too_many_arguments)]
 pub fn step(
     level: Level,
     fields: &[RawField],
     waves: &[RawWave],
     stems: &[StemLanes],
+    coefficients: &[OscLanes],
     prev: &[StateLanes],
     step: LaneStep,
     next: &mut [StateLanes],
 ) {
+    assert_eq!(coefficients.len(), stems.len(), "skjermo_lanes::step: oscillator coefficients per group");
     assert!(
         prev.len() == stems.len() && next.len() == stems.len(),
         "skjermo_lanes::step: {} stem groups, {} and {} state groups",
@@ -266,8 +323,10 @@ pub fn step(
     // The AVX2 gather indexes `prev` in floats with i32.
     let fast_gather =
         level.min(crate::simd::detected()) == Level::Avx2 && prev.len() * STATE_FLOATS <= i32::MAX as usize;
-    next.par_chunks_mut(16).zip(stems.par_chunks(16)).for_each(|(out, st)| {
-        groups_at(level, fields, waves, st, prev, step, fast_gather, out);
+    next.par_chunks_mut(16).zip(stems.par_chunks(16)).enumerate().for_each(|(c, (out, st))| {
+        let own = &prev[16 * c..16 * c + out.len()];
+        let cs = &coefficients[16 * c..16 * c + out.len()];
+        groups_at(level, fields, waves, st, cs, prev, own, step, fast_gather, out);
     });
 }
 
@@ -279,12 +338,14 @@ fn groups_at(
     fields: &[RawField],
     waves: &[RawWave],
     stems: &[StemLanes],
+    coefficients: &[OscLanes],
     prev: &[StateLanes],
+    own: &[StateLanes],
     step: LaneStep,
     fast_gather: bool,
     next: &mut [StateLanes],
 ) {
-    for (out, st) in next.iter_mut().zip(stems) {
+    for (((out, st), cs), was) in next.iter_mut().zip(stems).zip(coefficients).zip(own) {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: `fast_gather` is set only at the AVX2 level, which `step` runs only where
         // the CPU has AVX2.
@@ -323,15 +384,32 @@ fn groups_at(
         out.delta[1] = d1;
         let d2 = moved(shift, &df, st.local[2]);
         let d3 = moved(shift, &df, st.local[3]);
-        // Wind at the tip, bend factors (eq. 16), length-keeping update (eq. 17).
+        // Wind at the tip and the static push b₃ = c ŵ (eq. 16), which the bend follows as
+        // the stem's damped first mode (or at once).
         let w = wind_lanes(fields, waves, st.rest_tip.add(d3), step.time);
         let u = w.length();
-        let theta = (st.drag * u * u).min(V::splat(step.max_bend));
+        let r = u / V::splat(step.reconfiguration_speed);
+        let g = if step.vogel_exponent == 0.0 { V::ONE } else { pow_ge1(V::ONE + r * r, 0.5 * step.vogel_exponent) };
+        let theta = (st.drag * u * u * g).min(V::splat(step.max_bend));
         let c = st.length * theta;
-        let bend = u.cmp_gt(V::ZERO) & c.cmp_gt(V::ZERO);
-        let cu = c / bend.blend(u, V::ONE);
-        let b3 = w.scale(cu);
-        let b2 = w.scale(cu * V::splat(step.p2_factor));
+        let pushed = u.cmp_gt(V::ZERO) & c.cmp_gt(V::ZERO);
+        let cu = c / pushed.blend(u, V::ONE);
+        let push = V3::select(pushed, w.scale(cu), V3::ZERO);
+        let b3 = if step.dynamics {
+            // `physics::oscillator::damped_apply`, lane by lane, then the air's damping.
+            let x = was.bend.sub(push);
+            let bend = push.add(x.scale(cs.c)).add(was.rate.add(x.scale(st.damping)).scale(cs.s));
+            let rate = was.rate.scale(cs.c).sub(was.rate.scale(st.damping).add(x.scale(st.w2)).scale(cs.s));
+            out.bend = bend;
+            out.rate = rate.scale(V::ONE / (V::ONE + st.aero * u * g * V::splat(step.dt)));
+            bend
+        } else {
+            out.bend = V3::ZERO;
+            out.rate = V3::ZERO;
+            push
+        };
+        let bend = b3.dot(b3).cmp_gt(V::ZERO);
+        let b2 = b3.scale(V::splat(step.p2_factor));
         // The legs P1→P2 and P2→P3 as they are now: the rest legs turned with the frame (the
         // same vectors as the differences of the moved points, without storing the rest
         // points; the step is bound by memory traffic at the larger sizes).

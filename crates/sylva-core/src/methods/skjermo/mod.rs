@@ -10,10 +10,24 @@
 //! 2. **Wind**: the scene's velocity F at the re-attached tip P3.
 //! 3. **Bend** (eqs. 15–17): bend factors `b₃ = c F̂·1^e`, `b₂ = c F̂·(1/3)^e` with the
 //!    published exponent e = 1.8 (configurable), where `c = L θ` scales by the stem's length
-//!    and its static bend `θ = min(max_bend, drag · |F|²)` (drag over stiffness, as in
-//!    Zioma's method); then `P'ᵢ = P'ᵢ₋₁ + |Pᵢ − Pᵢ₋₁| · normalize(Pᵢ − Pᵢ₋₁ + bᵢ)` for
-//!    i = 2, 3, which keeps the control polygon's lengths (P0, P1 stay: the branch grows out
-//!    of its parent).
+//!    and its static bend `θ = min(max_bend, drag · |F|²)`; then
+//!    `P'ᵢ = P'ᵢ₋₁ + |Pᵢ − Pᵢ₋₁| · normalize(Pᵢ − Pᵢ₋₁ + bᵢ)` for i = 2, 3, which keeps the
+//!    control polygon's lengths (P0, P1 stay: the branch grows out of its parent).
+//!
+//! **The bend as a damped oscillator** (`dynamics`, on by default). Published, `b₃` follows
+//! the wind at once: a stem has no frequency and stops dead when the wind does. Here `b₃`
+//! is each stem's first bending mode driven toward the static push `c F̂`:
+//! `b¨ + (2ζω + a_air u) b˙ + ω² (b − c F̂) = 0`, stepped exactly
+//! ([`crate::physics::oscillator`]), so the frequency does not depend on the time step.
+//! * ω: the stem's first mode from its wood, sections and everything it carries
+//!   ([`crate::physics::beam`], Rayleigh's quotient); ζ: wood's structural damping.
+//! * The drag factor is set so that the tip's static deflection, `(1 + (1/3)^e) c`, is the
+//!   beam's under the drag on the stem and everything growing from it
+//!   (`physics::beam::drag_bend`), `½ ρ u²` on each segment's `C_d A` of bark and
+//!   leaves.
+//! * Aerodynamic damping from drag on a moving stem, `F(w − v)`: linearised about the wind,
+//!   the push drops by `2 c/u` per m/s the stem's centre of pressure moves downwind, which
+//!   moves at `DragBend::pressure_centre` of the tip's speed; applied implicitly.
 //!
 //! Because a stem reads its parent's previous curve, motion reaches level d one step after
 //! level d − 1: **level d lags d steps** behind the trunk (§5); at 60 steps/s a four-level
@@ -30,12 +44,13 @@ pub mod raw;
 
 pub use raw::*;
 
-use self::lanes::{LANES, LaneStep, StateLanes, StemLanes};
+use self::lanes::{LANES, LaneStep, OscLanes, StateLanes, StemLanes};
 use super::{Animator, Method, MethodError, MethodOptions, Simulation, check};
 use crate::model::{NONE, Tree};
 use crate::pose::{Curves, Pose, SeamPose};
 use crate::wind::PackedWind;
 use crate::wind::raw::{RawField, RawWave};
+use bytemuck::Zeroable;
 use glam::{Vec3, Vec4};
 use kernels::{skjermo_rotations, skjermo_step};
 use rayon::prelude::*;
@@ -49,15 +64,40 @@ pub struct SkjermoParams {
     pub exponent: f32,
     /// Weight of P2's bend factor before the exponent (printed: 1/3).
     pub p2_weight: f32,
-    /// Largest static bend of a stem, rad.
+    /// Largest static bend of a stem, rad (0.6: branches past ~35° in wind break or shed).
     pub max_bend: f32,
-    /// Drag coefficient of bark and leaves for the static bend (as in Zioma's method).
+    /// Drag coefficient C_d of bark ([`crate::physics::BRANCH_DRAG`]).
     pub drag: f32,
+    /// Effective drag coefficient per unit leaf area ([`crate::physics::LEAF_DRAG`]; leaves
+    /// and twigs of a crown so dense that they would drag more than the crown as a body are
+    /// sheltered, [`crate::physics::crown_shelter`]).
+    pub leaf_drag: f32,
+    /// The bend follows the wind as each stem's damped first mode (true), or at once as
+    /// published (false).
+    pub dynamics: bool,
+    /// Reconfiguration speed U_r, m/s: above it drag grows as `u^(2+B)`
+    /// ([`crate::physics::DragModel`]).
+    pub reconfiguration_speed: f32,
+    /// Vogel exponent B (−0.7, Vogel 1989; 0 keeps drag quadratic).
+    pub vogel_exponent: f32,
+    /// Structural damping ratio ζ of the wood ([`crate::physics::STRUCTURAL_DAMPING`]); the
+    /// air's damping adds to it and grows with the wind.
+    pub damping_ratio: f32,
 }
 
 impl Default for SkjermoParams {
     fn default() -> Self {
-        Self { exponent: 1.8, p2_weight: 1.0 / 3.0, max_bend: 0.6, drag: crate::physics::BRANCH_DRAG }
+        Self {
+            exponent: 1.8,
+            p2_weight: 1.0 / 3.0,
+            max_bend: 0.6,
+            drag: crate::physics::BRANCH_DRAG,
+            leaf_drag: crate::physics::LEAF_DRAG,
+            dynamics: true,
+            reconfiguration_speed: crate::physics::DragModel::default().reconfiguration_speed,
+            vogel_exponent: crate::physics::DragModel::default().vogel_exponent,
+            damping_ratio: crate::physics::STRUCTURAL_DAMPING,
+        }
     }
 }
 
@@ -70,6 +110,8 @@ pub struct Skjermo {
     pub stems: Vec<RawSkjermoStem>,
     /// Rest orientation vector of each stem.
     pub rest_orient: Vec<[f32; 4]>,
+    /// Per-stem oscillator constants (after editing them, call [`Skjermo::rebuild_lanes`]).
+    pub modes: Vec<RawSkjermoMode>,
     /// Per-segment (stem, Bézier parameter of the segment's middle).
     pub segment_param: Vec<[f32; 4]>,
     /// The per-stem constants in groups of sixteen for the fast CPU step.
@@ -82,6 +124,8 @@ pub struct Skjermo {
 pub struct SkjermoState {
     /// Per-stem state.
     pub stems: Vec<RawSkjermoState>,
+    /// Per-stem bend oscillators.
+    pub sway: Vec<RawSkjermoSway>,
     /// Steps taken.
     pub steps: u64,
     /// Simulated time, s.
@@ -94,6 +138,8 @@ pub struct SkjermoState {
     /// is copied from it after every step).
     pub lanes: Vec<StateLanes>,
     scratch: Vec<StateLanes>,
+    /// The oscillators' step coefficients per group for the step length `.0`.
+    coefficients: (f32, Vec<OscLanes>),
 }
 
 /// Bézier point.
@@ -148,6 +194,14 @@ impl Skjermo {
         let ctrl = |k: usize| st.bezier[k];
         let mut stems = Vec::with_capacity(st.len());
         let mut rest_orient = vec![[0.0f32; 4]; st.len()];
+        let min_radius = crate::physics::MIN_RADIUS;
+        let beam = crate::physics::stem_frequencies(tree, min_radius);
+        let shelter = crate::physics::crown_shelter(tree, params.drag, params.leaf_drag);
+        let cd_area = crate::physics::beam::drag_areas(tree, params.drag, params.leaf_drag, shelter);
+        let bend = crate::physics::beam::drag_bend(tree, min_radius, &cd_area);
+        // The tip moves by b₂ + b₃ = (1 + p2_factor) b₃.
+        let tip_gain = 1.0 + params.p2_weight.powf(params.exponent);
+        let pressure = 0.5 * crate::physics::AIR_DENSITY;
         for k in 0..st.len() {
             let p = ctrl(k);
             let (attach, f) = if st.parent[k] == NONE {
@@ -172,7 +226,7 @@ impl Skjermo {
                 local,
                 parent: st.parent[k],
                 attach,
-                drag: crate::physics::StemLoad::of(tree, k).bend_per_u2() * params.drag / crate::physics::BRANCH_DRAG,
+                drag: pressure * bend.tip[k] / (st.length[k].max(1e-4) * tip_gain),
                 length: st.length[k],
                 parent_orient: if st.parent[k] == NONE { [0.0; 4] } else { rest_orient[st.parent[k] as usize] },
             });
@@ -185,13 +239,23 @@ impl Skjermo {
                 [f32::from_bits(k as u32), closest_param(&ctrl(k), mid), 0.0, 0.0]
             })
             .collect();
-        let (lanes, rest_lanes) = lanes::build(&stems, &rest_orient);
-        Self { params, stems, rest_orient, segment_param, lanes, rest_lanes }
+        let modes = stems
+            .iter()
+            .zip(beam.omega.iter().zip(&bend.pressure_centre))
+            .map(|(stem, (&w, &centre))| RawSkjermoMode {
+                w2: w * w,
+                damping: params.damping_ratio * w,
+                aero: w * w * 2.0 * centre * tip_gain * stem.length * stem.drag,
+                _pad: 0.0,
+            })
+            .collect::<Vec<_>>();
+        let (lanes, rest_lanes) = lanes::build(&stems, &modes, &rest_orient);
+        Self { params, stems, rest_orient, modes, segment_param, lanes, rest_lanes }
     }
 
     /// Rebuilds the fast path's lane groups from `stems` (after editing them).
     pub fn rebuild_lanes(&mut self) {
-        (self.lanes, self.rest_lanes) = lanes::build(&self.stems, &self.rest_orient);
+        (self.lanes, self.rest_lanes) = lanes::build(&self.stems, &self.modes, &self.rest_orient);
     }
 
     /// Per-step values.
@@ -201,13 +265,24 @@ impl Skjermo {
             exponent: self.params.exponent,
             p2_weight: self.params.p2_weight,
             max_bend: self.params.max_bend,
-            _pad: [0.0; 4],
+            dt: 0.0,
+            dynamics: self.params.dynamics as u32,
+            reconfiguration_speed: self.params.reconfiguration_speed,
+            vogel_exponent: self.params.vogel_exponent,
         }
     }
 
     /// Per-step values of the fast CPU step.
-    pub fn lane_step(&self, time: f32) -> LaneStep {
-        LaneStep { time, p2_factor: self.params.p2_weight.powf(self.params.exponent), max_bend: self.params.max_bend }
+    pub fn lane_step(&self, time: f32, dt: f32) -> LaneStep {
+        LaneStep {
+            time,
+            dt,
+            p2_factor: self.params.p2_weight.powf(self.params.exponent),
+            max_bend: self.params.max_bend,
+            dynamics: self.params.dynamics,
+            reconfiguration_speed: self.params.reconfiguration_speed,
+            vogel_exponent: self.params.vogel_exponent,
+        }
     }
 
     /// Advances only the stems' curves one step of `dt` seconds (no pose): every stem
@@ -215,13 +290,17 @@ impl Skjermo {
     /// This is the branch update Skjermo's figures count.
     pub fn step_stems(&self, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
         let t = state.time + dt;
+        if state.coefficients.0 != dt || state.coefficients.1.len() != self.lanes.len() {
+            state.coefficients = (dt, lanes::coefficients(&self.lanes, dt));
+        }
         lanes::step(
             crate::simd::level(),
             fields,
             waves,
             &self.lanes,
+            &state.coefficients.1,
             &state.lanes,
-            self.lane_step(t),
+            self.lane_step(t, dt),
             &mut state.scratch,
         );
         std::mem::swap(&mut state.lanes, &mut state.scratch);
@@ -235,7 +314,8 @@ impl Skjermo {
     pub fn step_reference(&self, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
         let t = state.time + dt;
         let mut next = state.stems.clone();
-        skjermo_step(fields, waves, &self.stems, &state.stems, self.step_params(t), &mut next);
+        let step = RawSkjermoStep { dt, ..self.step_params(t) };
+        skjermo_step(fields, waves, &self.stems, &state.stems, step, &mut next, &self.modes, &mut state.sway);
         state.stems = next;
         state.time = t;
         state.steps += 1;
@@ -268,7 +348,17 @@ impl SkjermoParams {
         check(m, "exponent", self.exponent, self.exponent > 0.0 && self.exponent <= 16.0, "0 to 16")?;
         check(m, "p2_weight", self.p2_weight, (0.0..=1.0).contains(&self.p2_weight), "0 to 1")?;
         check(m, "max_bend", self.max_bend, self.max_bend > 0.0 && self.max_bend <= 3.2, "0 to π rad")?;
-        check(m, "drag", self.drag, self.drag >= 0.0, "a finite number ≥ 0")
+        check(m, "drag", self.drag, self.drag >= 0.0, "a finite number ≥ 0")?;
+        check(m, "leaf_drag", self.leaf_drag, self.leaf_drag >= 0.0, "a finite number ≥ 0")?;
+        check(
+            m,
+            "reconfiguration_speed",
+            self.reconfiguration_speed,
+            self.reconfiguration_speed > 0.0,
+            "a number > 0 m/s",
+        )?;
+        check(m, "vogel_exponent", self.vogel_exponent, (-2.0..=0.0).contains(&self.vogel_exponent), "−2 to 0")?;
+        check(m, "damping_ratio", self.damping_ratio, (0.0..=2.0).contains(&self.damping_ratio), "0 to 2")
     }
 }
 
@@ -290,12 +380,14 @@ impl Method for Skjermo {
     fn rest_state(&self, tree: &Tree) -> SkjermoState {
         SkjermoState {
             stems: self.rest_orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect(),
+            sway: vec![RawSkjermoSway::zeroed(); self.stems.len()],
             steps: 0,
             time: 0.0,
             pose: Pose { bezier: Some(tree.stems.bezier.clone()), ..Pose::rest(tree) },
             acc: vec![[0.0, 0.0, 0.0, 1.0]; tree.segments.len()],
             lanes: self.rest_lanes.clone(),
             scratch: self.rest_lanes.clone(),
+            coefficients: (0.0, Vec::new()),
         }
     }
 
@@ -304,12 +396,16 @@ impl Method for Skjermo {
     fn step(&self, tree: &Tree, wind: &PackedWind, state: &mut SkjermoState, dt: f32) {
         self.step_stems(&wind.fields, &wind.waves, state, dt);
         let lanes = &state.lanes;
-        state.stems.par_iter_mut().enumerate().for_each(|(k, s)| {
+        state.stems.par_iter_mut().zip(state.sway.par_iter_mut()).enumerate().for_each(|(k, (s, sw))| {
             let g = &lanes[k / LANES];
             let l = k % LANES;
             *s = RawSkjermoState {
                 delta: [0, 1, 2, 3].map(|j| g.delta(l, j).extend(0.0).to_array()),
                 orient: g.orient(l).extend(0.0).to_array(),
+            };
+            *sw = RawSkjermoSway {
+                bend: g.bend.lane(l).extend(0.0).to_array(),
+                rate: g.rate.lane(l).extend(0.0).to_array(),
             };
         });
         self.update_pose(tree, state);

@@ -11,6 +11,32 @@ pub type RawSkjermoStem = crate::pose::RawCurveStem;
 /// orientation vector, 80 bytes. WGSL: `SkjermoState`.
 pub type RawSkjermoState = crate::pose::RawStemCurve;
 
+/// Per-stem oscillator constants of the second-order bend, 16 bytes. WGSL: `SkjermoMode`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawSkjermoMode {
+    /// Squared natural frequency of the stem's first mode ω², rad²/s².
+    pub w2: f32,
+    /// Structural damping rate ζω, 1/s.
+    pub damping: f32,
+    /// Aerodynamic damping per m/s of wind, 1/m: the bend's velocity is damped at `aero · u`
+    /// (1/s).
+    pub aero: f32,
+    /// Padding.
+    pub _pad: f32,
+}
+
+/// Per-stem bend of the second-order response (updated in place; each stem reads only its
+/// own), 32 bytes. WGSL: `SkjermoSway`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawSkjermoSway {
+    /// The tip's bend vector b₃ (eq. 16's push, xyz), m.
+    pub bend: [f32; 4],
+    /// Its rate of change (xyz), m/s.
+    pub rate: [f32; 4],
+}
+
 /// Per-step values, 32 bytes. WGSL: `SkjermoStep`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
@@ -23,6 +49,12 @@ pub struct RawSkjermoStep {
     pub p2_weight: f32,
     /// Largest static bend, rad.
     pub max_bend: f32,
-    /// Padding.
-    pub _pad: [f32; 4],
+    /// Step length, s.
+    pub dt: f32,
+    /// 1: the bend follows the wind as a damped oscillator; 0: at once, as published.
+    pub dynamics: u32,
+    /// Reconfiguration speed U_r, m/s.
+    pub reconfiguration_speed: f32,
+    /// Vogel exponent B.
+    pub vogel_exponent: f32,
 }

@@ -40,32 +40,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let stiffen = stiffening(length(tau) / a.stiffness, step.stiffening_angle);
     let k = a.stiffness * stiffen;
     let c = a.damping * sqrt(stiffen) + gamma;
-    // The exact step of x'' + 2 a x' + w2 (x - x_eq) = 0 (kernels::damped_step).
+    // The exact step of x'' + 2 a x' + w2 (x - x_eq) = 0 (physics::oscillator::damped_step).
     let w2 = k / a.inertia;
     let damp = c / (2.0 * a.inertia);
-    let disc = w2 - damp * damp;
-    var cc: f32;
-    var ss: f32;
-    if (disc > 0.0) {
-        let wd = sqrt(disc);
-        let e = exp(-damp * step.dt);
-        cc = e * cos(wd * step.dt);
-        ss = e * sin(wd * step.dt) / wd;
-    } else {
-        let b = sqrt(-disc);
-        let e1 = exp((b - damp) * step.dt);
-        let e2 = exp(-(damp + b) * step.dt);
-        cc = 0.5 * (e1 + e2);
-        if (b > 1e-6) {
-            ss = 0.5 * (e1 - e2) / b;
-        } else {
-            ss = e1 * step.dt;
-        }
-    }
-    let x_eq = tau / k;
-    let x = t0 - x_eq;
-    var t1 = x_eq + x * cc + (w0 + x * damp) * ss;
-    var w1 = w0 * cc - (w0 * damp + x * w2) * ss;
+    let next = damped_apply(t0, w0, tau / k, w2, damp, damped_coefficients(w2, damp, step.dt));
+    var t1 = next.x;
+    var w1 = next.v;
     // The hard stop at three stiffening angles.
     let bend = length(t1);
     let stop = 3.0 * step.stiffening_angle;

@@ -7,11 +7,12 @@ use crate::kernel::{Kernel, output, read_back, upload};
 use crate::pose::GpuPose;
 use crate::wind::GpuWind;
 use crate::{GpuContext, GpuError};
+use bytemuck::Zeroable;
 use glam::Vec3;
 use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::methods::MethodOptions;
-use sylva_core::methods::skjermo::{RawSkjermoState, RawSkjermoStep, Skjermo, SkjermoParams};
+use sylva_core::methods::skjermo::{RawSkjermoState, RawSkjermoStep, RawSkjermoSway, Skjermo, SkjermoParams};
 use sylva_core::pose::{Placement, Pose};
 
 /// Skjermo's method on the GPU for one tree.
@@ -27,6 +28,8 @@ pub struct GpuSkjermo {
     step: wgpu::Buffer,
     state: [wgpu::Buffer; 2],
     current: usize,
+    modes: wgpu::Buffer,
+    sway: wgpu::Buffer,
     /// The rest state as the device rounds it.
     rest: Vec<RawSkjermoState>,
     /// Each stem's rest control points.
@@ -64,6 +67,8 @@ impl GpuSkjermo {
             step: upload(ctx, "skjermo step", &[method.step_params(0.0)])?,
             state: [upload(ctx, "skjermo state a", &rest)?, upload(ctx, "skjermo state b", &rest)?],
             current: 0,
+            modes: upload(ctx, "skjermo modes", &method.modes)?,
+            sway: upload(ctx, "skjermo sway", &vec![RawSkjermoSway::zeroed(); method.stems.len()])?,
             rest,
             rest_curves: method.stems.iter().map(|s| s.rest.map(|p| Vec3::from_slice(&p[..3]))).collect(),
             method_step: method.step_params(0.0),
@@ -113,14 +118,14 @@ impl GpuSkjermo {
 
     fn step_with(&mut self, ctx: &GpuContext, dt: f32, with_pose: bool) {
         self.time += dt;
-        let step = RawSkjermoStep { time: self.time, ..self.method_step };
+        let step = RawSkjermoStep { time: self.time, dt, ..self.method_step };
         ctx.queue.write_buffer(&self.step, 0, bytemuck::bytes_of(&step));
         let (prev, next) = (&self.state[self.current], &self.state[1 - self.current]);
         let mut e = ctx.device.create_command_encoder(&Default::default());
         self.step_kernel.record(
             ctx,
             &mut e,
-            &[&self.wind.fields, &self.wind.waves, &self.stems, prev, &self.step, next],
+            &[&self.wind.fields, &self.wind.waves, &self.stems, prev, &self.step, next, &self.modes, &self.sway],
             self.rest.len() as u32,
         );
         if with_pose {
@@ -180,6 +185,7 @@ impl GpuAnimator for GpuSkjermo {
         for s in &self.state {
             ctx.queue.write_buffer(s, 0, bytemuck::cast_slice(&self.rest));
         }
+        ctx.queue.write_buffer(&self.sway, 0, bytemuck::cast_slice(&vec![RawSkjermoSway::zeroed(); self.rest.len()]));
         self.current = 0;
         self.pose.write_rest(ctx, &self.tree);
         self.time = time;

@@ -1,5 +1,6 @@
 // Shared by Skjermo's kernels: structs and Bezier helpers. Twins:
-// sylva_core::methods::skjermo::{RawSkjermoStem, RawSkjermoState, RawSkjermoStep, bezier,
+// sylva_core::methods::skjermo::{RawSkjermoStem, RawSkjermoState, RawSkjermoStep, RawSkjermoMode,
+// RawSkjermoSway, bezier,
 // bezier_d, frame}.
 
 struct SkjermoStem {
@@ -22,7 +23,22 @@ struct SkjermoStep {
     exponent: f32,
     p2_weight: f32,
     max_bend: f32,
-    _pad: vec4<f32>,
+    dt: f32,
+    dynamics: u32,
+    reconfiguration_speed: f32,
+    vogel_exponent: f32,
+}
+
+struct SkjermoMode {
+    w2: f32,
+    damping: f32,
+    aero: f32,
+    _pad: f32,
+}
+
+struct SkjermoSway {
+    bend: vec4<f32>,
+    rate: vec4<f32>,
 }
 
 struct Curve {

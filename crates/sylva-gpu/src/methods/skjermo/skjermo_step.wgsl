@@ -1,11 +1,14 @@
 // skjermo_step: re-attach every stem on its parent's previous curve and bend P2, P3
-// (eqs. 15-17). CPU twin: sylva_core::methods::skjermo::kernels::skjermo_step (bindings 0 fields,
-// 1 waves, 2 stems, 3 previous state, 4 step, 5 next state).
+// (eqs. 15-17), the bend following the wind as the stem's damped first mode. CPU twin:
+// sylva_core::methods::skjermo::kernels::skjermo_step (bindings 0 fields, 1 waves, 2 stems,
+// 3 previous state, 4 step, 5 next state, 6 modes, 7 sway).
 
 @group(0) @binding(2) var<storage, read> stems: array<SkjermoStem>;
 @group(0) @binding(3) var<storage, read> prev: array<SkjermoState>;
 @group(0) @binding(4) var<storage, read> step: SkjermoStep;
 @group(0) @binding(5) var<storage, read_write> next: array<SkjermoState>;
+@group(0) @binding(6) var<storage, read> modes: array<SkjermoMode>;
+@group(0) @binding(7) var<storage, read_write> sway: array<SkjermoSway>;
 
 fn safe_normalize(v: vec3<f32>) -> vec3<f32> {
     let l = length(v);
@@ -49,13 +52,25 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let a3 = rest.p[3] + d[3];
     let w = wind_at(a3, step.time);
     let u = length(w);
+    let r = u / step.reconfiguration_speed;
+    let g = pow(1.0 + r * r, 0.5 * step.vogel_exponent);
+    let theta = min(st.drag * u * u * g, step.max_bend);
+    let c = st.length * theta;
+    var b3 = vec3<f32>(0.0);
+    if (u > 0.0 && c > 0.0) {
+        b3 = w * (c / u);
+    }
+    if (step.dynamics != 0u) {
+        let m = modes[k];
+        let next_sway = damped_apply(sway[k].bend.xyz, sway[k].rate.xyz, b3, m.w2, m.damping, damped_coefficients(m.w2, m.damping, step.dt));
+        let rate = next_sway.v * (1.0 / (1.0 + m.aero * u * g * step.dt));
+        sway[k] = SkjermoSway(vec4<f32>(next_sway.x, 0.0), vec4<f32>(rate, 0.0));
+        b3 = next_sway.x;
+    }
     var c2 = vec3<f32>(0.0);
     var c3 = vec3<f32>(0.0);
-    let theta = min(st.drag * u * u, step.max_bend);
-    let c = st.length * theta;
-    if (u > 0.0 && c > 0.0) {
-        let b3 = w * (c / u);
-        let b2 = w * (c * pow(step.p2_weight, step.exponent) / u);
+    if (dot(b3, b3) > 0.0) {
+        let b2 = b3 * pow(step.p2_weight, step.exponent);
         let d2 = a2 - a1;
         c2 = safe_normalize(d2 + b2) * length(d2) - d2;
         let p2 = a2 + c2;
