@@ -36,7 +36,7 @@
 //! # Data
 //! The topology (index buffers, the ring table) is built once per tree by [`MeshLayout`];
 //! per frame only vertices are computed, from the pose as the GPU pose seam stores it
-//! (joint positions and accumulated rotations `D`, see [`crate::animate`]). The CPU
+//! (joint positions and accumulated rotations `D`, see [`crate::pose`]). The CPU
 //! references `mesh::mesh_tubes` and `mesh::mesh_leaves` are the twins of
 //! `sylva-gpu`'s `mesh_tubes.wgsl` and `mesh_leaves.wgsl` (one invocation per vertex).
 

@@ -1,7 +1,7 @@
 //! Each stem's first bending mode and static bend, as a continuous tapered cantilever: the
 //! natural frequency from the wood (E, density), its sections and the mass it carries (its
 //! own wood and leaves, and every stem growing from it, lumped where it starts), and the
-//! tip's deflection under the drag on all of that ([`tip_deflections`]).
+//! tip's deflection under the drag on all of that ([`drag_bend`]).
 //!
 //! The beam is integrated in [`PIECES`] pieces per segment, each with the section at its
 //! middle (radii tapering from the segment's base to its tip, never under the minimum

@@ -1,5 +1,5 @@
 //! CPU twins of `pose_accumulate.wgsl` and `pose_positions.wgsl`: forward
-//! kinematics by ancestor walks (see [`crate::animate`]). Every segment walks its own chain,
+//! kinematics by ancestor walks (see [`crate::pose`]). Every segment walks its own chain,
 //! in parallel, exactly as a GPU invocation does. `pose_level.wgsl`'s twin,
 //! [`pose_level`], is the level-by-level alternative (one dispatch per depth).
 

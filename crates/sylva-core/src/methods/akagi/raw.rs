@@ -32,11 +32,11 @@ pub struct RawAkagiStep {
     pub time: f32,
     /// Step, s.
     pub dt: f32,
-    /// See [`AkagiParams::reconfiguration_speed`].
+    /// See [`super::AkagiParams::reconfiguration_speed`].
     pub reconfiguration_speed: f32,
-    /// See [`AkagiParams::stiffening_angle`].
+    /// See [`super::AkagiParams::stiffening_angle`].
     pub stiffening_angle: f32,
-    /// See [`AkagiParams::vogel_exponent`].
+    /// See [`super::AkagiParams::vogel_exponent`].
     pub vogel_exponent: f32,
     /// Padding.
     pub _pad: [f32; 2],

@@ -35,7 +35,7 @@ pub struct RawHsmCluster {
     pub rest_cm: [f32; 4],
     /// Parent cluster (`u32::MAX` for the root).
     pub parent: u32,
-    /// First of the cluster's children in [`HsmLayout::children`].
+    /// First of the cluster's children in [`super::HsmLayout::children`].
     pub child_offset: u32,
     /// Number of child clusters.
     pub child_count: u32,
@@ -100,7 +100,7 @@ impl RawHsmClusterState {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawHsmStep {
-    /// Gravity (xyz), m/s²; w = 1 when prestressed (see [`HsmParams::prestressed`]).
+    /// Gravity (xyz), m/s²; w = 1 when prestressed (see [`super::HsmParams::prestressed`]).
     pub gravity: [f32; 4],
     /// Substep h, s.
     pub dt: f32,
@@ -120,5 +120,5 @@ pub struct RawHsmStep {
     pub max_children: u32,
 }
 
-/// [`HsmState::velocity`]'s w for a fixed particle (free ones carry their drag factor ≥ 0).
+/// [`super::HsmState::velocity`]'s w for a fixed particle (free ones carry their drag factor ≥ 0).
 pub const FIXED: f32 = -1.0;

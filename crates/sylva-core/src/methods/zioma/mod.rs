@@ -19,7 +19,7 @@
 //! * **Phase** (§6.3.3): a random phase per stem, from the seed; **inertia**: branches lag
 //!   the trunk by `−inertia · trunk rate / (2π f)`.
 //! * **Hierarchy** (§6.4): per-branch angles become quaternions, concatenated from the root
-//!   down by the pose seam ([`crate::animate`]); **LOD**: trunk only, or trunk and branches.
+//!   down by the pose seam ([`crate::pose`]); **LOD**: trunk only, or trunk and branches.
 
 pub mod raw;
 pub mod rotations;
