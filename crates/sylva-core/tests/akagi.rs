@@ -52,8 +52,9 @@ fn constant_wind_bends_downwind_more_as_it_rises() {
     }
 }
 
-/// One segment, released from a deflection: it rings at the damped spring frequency
-/// ω_d = √(k/I) · √(1 − ζ²), I = m L²/3 about its base.
+/// One segment, released from a deflection: it rings at its stem's first mode (the
+/// continuous cantilever's, `physics::beam`), damped: ω_d = ω · √(1 − ζ²). Its joint is the
+/// spring k = E I / L with the modal inertia k / ω².
 #[test]
 fn a_single_cantilever_rings_at_the_spring_frequency() {
     let t = Grammar::parse("width-scale: 0.02\naxiom: !(1)F(1)\n", "one.lsys")
@@ -62,10 +63,8 @@ fn a_single_cantilever_rings_at_the_spring_frequency() {
         .unwrap();
     let params = AkagiParams { damping_ratio: 0.05, ..Default::default() };
     let a = Akagi::new(&t, params);
-    let s0 = &t.segments;
-    let (m, l) = (s0.mass[0], s0.length[0]);
-    let wn = (s0.stiffness[0] / (m * l * l / 3.0)).sqrt();
-    assert!((a.natural_frequency(0) - wn).abs() < 1e-3 * wn);
+    let wn = sylva_core::physics::stem_frequencies(&t, params.min_radius).omega[0];
+    assert!(wn > 0.0 && (a.natural_frequency(0) - wn).abs() < 1e-3 * wn, "{} vs {wn}", a.natural_frequency(0));
     let wd = wn * (1.0 - 0.05f32 * 0.05).sqrt();
     // Deflect by a steady wind, then stop it.
     let mut s = a.rest_state(&t);
