@@ -780,8 +780,18 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
     assert!(out.contains("Moore & Maguire") && out.contains("| akagi |"), "{out}");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("f/fidelity.json")).unwrap()).unwrap();
-    let rows = json.as_array().unwrap();
+    let rows = json["runs"].as_array().unwrap();
     assert_eq!(rows.len(), 4, "two sizes × two methods");
+    // Neighbours of the first size, per method: the correlation falls from 2 m to 20 m across
+    // the wind, and a downwind neighbour follows (a positive lag).
+    let near = json["neighbours"].as_array().unwrap();
+    assert_eq!(near.len(), 8, "two methods × four distances");
+    for m in ["akagi", "zioma"] {
+        let mine: Vec<&serde_json::Value> = near.iter().filter(|r| r["method"] == m).collect();
+        let across = |k: usize| mine[k]["crosswind"].as_f64().unwrap();
+        assert!(across(0) > across(3) && across(0) <= 1.0, "{m}: {mine:?}");
+        assert!(mine.iter().all(|r| r["lag"].as_f64().unwrap() > 0.0), "{m}: {mine:?}");
+    }
     for r in rows {
         let h = r["height"].as_f64().unwrap();
         assert!(h > 1.0 && r["dbh"].as_f64().unwrap() > 0.0);
@@ -794,8 +804,8 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
         }
     }
     let md = std::fs::read_to_string(dir.path().join("f/fidelity.md")).unwrap();
-    assert_eq!(md.lines().filter(|l| l.starts_with("| quaking_aspen")).count(), 4, "{md}");
-    for png in ["frequency.png", "damping.png", "bend.png"] {
+    assert_eq!(md.lines().filter(|l| l.starts_with("| quaking_aspen")).count(), 4 + 8, "{md}");
+    for png in ["frequency.png", "damping.png", "bend.png", "neighbours.png"] {
         assert_eq!(&std::fs::read(dir.path().join("f").join(png)).unwrap()[..4], b"\x89PNG", "{png}");
     }
     // Bad input names the flag.

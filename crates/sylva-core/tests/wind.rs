@@ -2,7 +2,9 @@
 //! promises, the turbulence spectrum, TOML round trips and errors.
 
 use glam::Vec3;
+use rand::{Rng, SeedableRng};
 use sylva_core::methods::zioma::trunk::TrunkNoise;
+use sylva_core::species::SpeciesSource;
 use sylva_core::wind::*;
 
 fn one(f: WindField) -> WindScene {
@@ -304,36 +306,103 @@ fn bad_scenes_name_the_line_and_field() {
     assert!(e.contains("field[1].components"), "{e}");
 }
 
+/// A thicker trunk sways faster and bends less; a taller one sways slower; calm air does not
+/// move it; the bend grows as `U² g(U)`; the oscillator's response has the textbook gain
+/// and lag; trees with different seeds move differently.
 #[test]
-fn trunk_noise_follows_size_and_stiffness() {
-    let slender = TrunkNoise::new(0.10, 12.0, 40.0, 8.0, 8e9, 800.0, 12.0);
-    let stout = TrunkNoise::new(0.25, 12.0, 40.0, 8.0, 8e9, 800.0, 12.0);
-    assert!(stout.natural_frequency > slender.natural_frequency);
-    assert!(stout.static_bend < slender.static_bend);
-    let tall = TrunkNoise::new(0.10, 24.0, 40.0, 8.0, 8e9, 800.0, 12.0);
-    assert!(tall.natural_frequency < slender.natural_frequency / 3.0);
-    // Stronger wind bends more (∝ U²); calm air does not move the trunk.
-    let calm = TrunkNoise::new(0.10, 12.0, 40.0, 8.0, 8e9, 800.0, 0.0);
-    assert_eq!(calm.angles(3.0, 1), [0.0; 3]);
-    let gale = TrunkNoise::new(0.10, 12.0, 40.0, 8.0, 8e9, 800.0, 24.0);
-    assert!((gale.static_bend / slender.static_bend - 4.0).abs() < 1e-3 || gale.static_bend == 0.35);
-    // Parallel motion leans away from the wind on average and dominates the other axes;
-    // trees with different seeds move differently.
-    let n = 20_000;
-    let mut mean = [0.0f64; 3];
-    let mut sq = [0.0f64; 3];
-    for i in 0..n {
-        let a = slender.angles(i as f32 * 0.05, 7);
-        for k in 0..3 {
-            mean[k] += a[k] as f64 / n as f64;
-            sq[k] += (a[k] as f64).powi(2) / n as f64;
-        }
+fn trunk_model_follows_size_stiffness_and_wind() {
+    use sylva_core::methods::zioma::trunk::TrunkModel;
+    use sylva_core::physics::{BRANCH_DRAG, DragModel, LEAF_DRAG};
+    let grown = |name: &str, scale: f64, ratio: f64| {
+        let SpeciesSource::WeberPenn { file, mut params } = SpeciesSource::resolve(name).unwrap() else { panic!() };
+        params.scale *= scale;
+        params.ratio *= ratio;
+        let t = SpeciesSource::WeberPenn { file, params }.generate(1, &Default::default(), None).unwrap();
+        TrunkModel::for_tree(&t, BRANCH_DRAG, LEAF_DRAG)
+    };
+    let (slender, stout, tall) =
+        (grown("quaking_aspen", 1.0, 1.0), grown("quaking_aspen", 1.0, 2.0), grown("quaking_aspen", 2.0, 1.0));
+    assert!(stout.natural_frequency > 1.5 * slender.natural_frequency, "{stout:?} {slender:?}");
+    assert!(stout.static_bend(10.0) < slender.static_bend(10.0) / 4.0);
+    assert!(tall.natural_frequency < slender.natural_frequency);
+    assert_eq!(slender.static_bend(0.0), 0.0);
+    let g = |u: f32| u * u * DragModel::default().reconfiguration(u);
+    let ratio = slender.static_bend(8.0) / slender.static_bend(4.0);
+    assert!((ratio / (g(8.0) / g(4.0)) - 1.0).abs() < 1e-4, "{ratio}");
+    // Damping: the wood's in still air, rising with the wind.
+    assert!((slender.damping(0.0) - slender.damping_ratio).abs() < 1e-7);
+    assert!(slender.damping(10.0) > slender.damping(5.0) && slender.damping(5.0) > slender.damping(0.0));
+    // Gain 1 and no lag far below f₀, 1/(2ζ) and a quarter turn at f₀, ~r⁻² and half a turn
+    // far above.
+    let f0 = slender.natural_frequency;
+    let (g0, l0) = slender.response(0.001 * f0, 0.05);
+    assert!((g0 - 1.0).abs() < 1e-4 && l0.abs() < 1e-3);
+    let (g1, l1) = slender.response(f0, 0.05);
+    assert!((g1 - 10.0).abs() < 1e-3 && (l1 - std::f32::consts::FRAC_PI_2).abs() < 1e-5, "{g1} {l1}");
+    let (g2, l2) = slender.response(10.0 * f0, 0.05);
+    assert!((g2 * 99.0 - 1.0).abs() < 0.01 && l2 > 3.1, "{g2} {l2}");
+    let noise = TrunkNoise::new(f0, 0.1);
+    assert_ne!(noise.angles(10.0, 1), noise.angles(10.0, 2));
+    assert_eq!(TrunkNoise::new(f0, 0.0).angles(3.0, 1), [0.0; 3]);
+}
+
+/// The wind through a filter of gain 1 and no lag is the wind; through a damped oscillator,
+/// a single sine at the natural frequency comes out 1/(2ζ) times as large and a quarter of a
+/// period late, and a constant wind passes unchanged.
+#[test]
+fn wind_through_a_filter_scales_and_delays_each_wave() {
+    use sylva_core::wind::sample::{wind_at, wind_through};
+    let wind = WindScene::resolve("gusty").unwrap().packed();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+    for _ in 0..2000 {
+        let p = Vec3::new(rng.random_range(-50.0..50.0), rng.random_range(0.0..20.0), rng.random_range(-50.0..50.0));
+        let t = rng.random_range(0.0..300.0);
+        let (a, b) =
+            (wind_at(&wind.fields, &wind.waves, p, t), wind_through(&wind.fields, &wind.waves, p, t, |_| (1.0, 0.0)));
+        assert!((a - b).length() < 1e-4 * (1.0 + a.length()), "{a} {b}");
     }
-    let theta = slender.static_bend as f64;
-    assert!((mean[0] - 0.8 * theta).abs() < 0.15 * theta, "{mean:?} θ {theta}");
-    let sd = |k: usize| (sq[k] - mean[k] * mean[k]).sqrt();
-    assert!(sd(0) > sd(1) && sd(1) > sd(2), "{} {} {}", sd(0), sd(1), sd(2));
-    assert_ne!(slender.angles(10.0, 1), slender.angles(10.0, 2));
+    // One turbulence-free sine of 0.5 Hz on top of 3 m/s.
+    let scene = WindScene::from_toml(
+        r#"
+        [[field]]
+        kind = "constant"
+        direction = [1.0, 0.0, 0.0]
+        speed = 3.0
+        [[field]]
+        kind = "sum_of_sines"
+        waves = [{ amplitude = 1.0, direction_deg = 0.0, wavelength = 12.0, speed = 6.0 }]
+        "#,
+        "sine.toml",
+    )
+    .unwrap();
+    let w = scene.packed();
+    let f0 = 0.5;
+    let h = |f: f32| {
+        let r = f / f0;
+        let (re, im) = (1.0 - r * r, 2.0 * 0.1 * r);
+        (1.0 / (re * re + im * im).sqrt(), im.atan2(re))
+    };
+    let dt = 0.01;
+    let series = |filtered: bool| -> Vec<f32> {
+        (0..4000)
+            .map(|k| {
+                let t = k as f32 * dt;
+                let v =
+                    if filtered { wind_through(&w.fields, &w.waves, Vec3::ZERO, t, h) } else { w.at(Vec3::ZERO, t) };
+                v.x
+            })
+            .collect()
+    };
+    let (raw, out) = (series(false), series(true));
+    let swing = |x: &[f32]| x.iter().cloned().fold(f32::MIN, f32::max) - x.iter().cloned().fold(f32::MAX, f32::min);
+    let mean = |x: &[f32]| x.iter().sum::<f32>() / x.len() as f32;
+    println!("swing {} → {}, mean {} → {}", swing(&raw), swing(&out), mean(&raw), mean(&out));
+    assert!((swing(&out) / swing(&raw) - 5.0).abs() < 0.05, "gain {}", swing(&out) / swing(&raw));
+    assert!((mean(&out) - mean(&raw)).abs() < 0.02, "the mean moved");
+    // The filtered wave peaks a quarter period (0.5 s) after the raw one.
+    let peak = |x: &[f32]| (0..200).max_by(|&a, &b| x[a].total_cmp(&x[b])).unwrap() as f32 * dt;
+    let lag = (peak(&out) - peak(&raw)).rem_euclid(2.0);
+    assert!((lag - 0.5).abs() < 0.03, "lag {lag} s");
 }
 
 /// Gusts travel downwind (frozen turbulence and the sum of sines' waves carried with the

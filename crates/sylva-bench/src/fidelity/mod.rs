@@ -3,8 +3,8 @@
 //!
 //! For every species of a size series and every method (through the runtime's registry,
 //! CPU, at `--rate`):
-//! - **pluck**: a steady 6 m/s wind, then still air; the trunk top's sway frequency (zero
-//!   crossings) and damping ratio (logarithmic decrement) as it rings down;
+//! - **pluck**: a steady 6 m/s wind, then still air; the trunk top's sway frequency (crossings
+//!   of rest while above 5 % of the release) and damping ratio (logarithmic decrement) as it rings down;
 //! - **step response** at 3, 6, 10 and 15 m/s: the lean (mean downwind bend of the trunk
 //!   top, % of height) and the damping ratio of the ringing about it;
 //! - **gusty** (the `gusty` preset, 6 m/s mean): the trunk top's sway (standard deviation of
@@ -15,7 +15,12 @@
 //! (Moore & Maguire 2004, 602 trees); damping ratios 0.02–0.2 rising with wind; trunk-top
 //! sway 0.5–3 % of height in a moderate breeze.
 //!
-//! Writes `fidelity.md`, `fidelity.json`, `frequency.png`, `damping.png` and `bend.png`.
+//! - **neighbours**: each species' reference tree beside copies of itself 2–20 m across the
+//!   mean wind and downwind, each simulated on its own in `gusty`: how their trunk tops'
+//!   motion correlates, and the lag at which a downwind neighbour follows.
+//!
+//! Writes `fidelity.md`, `fidelity.json`, `frequency.png`, `damping.png`, `bend.png` and
+//! `neighbours.png`.
 
 pub mod runs;
 
@@ -24,7 +29,7 @@ use crate::plot::{Series, plot_series};
 use anyhow::{Context, Result, bail};
 use plotters::style::RGBColor;
 use rayon::prelude::*;
-use runs::{FIELD, Protocol, Row, measure};
+use runs::{FIELD, NeighbourRow, Protocol, Row, measure, neighbours};
 use std::path::PathBuf;
 use sylva_core::physics::measure::linear_fit;
 
@@ -99,17 +104,50 @@ pub fn run(args: &FidelityArgs) -> Result<Vec<PathBuf>> {
         })
         .collect::<Result<_>>()?;
     bar.finish_and_clear();
+    // Neighbours of each species' reference size (×1, or the first), per method.
+    let reference = sizes.iter().copied().find(|s| (s - 1.0).abs() < 1e-9).unwrap_or(sizes[0]);
+    let mut pairs = Vec::new();
+    for species in list(&args.species) {
+        let tree = runs::grow(&species, reference)?;
+        for m in &methods {
+            pairs.push((species.clone(), m.clone(), tree.clone()));
+        }
+    }
+    println!("neighbours: {} runs", pairs.len() * (1 + 2 * runs::NEIGHBOUR_DISTANCES.len()));
+    let near: Vec<NeighbourRow> = pairs
+        .into_par_iter()
+        .map(|(species, m, tree)| neighbours(&registry, &m, &species, tree, protocol, 1.0 / args.rate))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .collect();
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("creating {}", args.out_dir.display()))?;
-    let md = report(&rows, &methods, args);
+    let md = report(&rows, &near, &methods, args);
     print!("{md}");
     let mut written = Vec::new();
     let path = args.out_dir.join("fidelity.md");
     write_atomic(&path, md.as_bytes())?;
     written.push(path);
     let path = args.out_dir.join("fidelity.json");
-    write_atomic(&path, serde_json::to_string_pretty(&rows)?.as_bytes())?;
+    let json = serde_json::json!({ "runs": rows, "neighbours": near });
+    write_atomic(&path, serde_json::to_string_pretty(&json)?.as_bytes())?;
     written.push(path);
     written.extend(plots(&rows, &methods, args)?);
+    let path = args.out_dir.join("neighbours.png");
+    let series = methods
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let pts = near
+                .iter()
+                .filter(|r| &r.method == m)
+                .map(|r| (r.distance as f64, (r.crosswind as f64).max(1e-3)))
+                .collect();
+            (leak(m.clone()), COLORS[k % COLORS.len()], pts)
+        })
+        .collect();
+    plot_series("Neighbours' sway correlation, across the wind", "distance, m", "correlation", series, &path)?;
+    written.push(path);
     Ok(written)
 }
 
@@ -185,7 +223,7 @@ fn opt(v: Option<f32>, digits: usize) -> String {
     v.map_or("–".into(), |v| format!("{v:.digits$}"))
 }
 
-fn report(rows: &[Row], methods: &[String], args: &FidelityArgs) -> String {
+fn report(rows: &[Row], near: &[NeighbourRow], methods: &[String], args: &FidelityArgs) -> String {
     let mut s = String::from("# Sylva fidelity report\n\n");
     s += &format!(
         "Date {}. Command `{}`. Simulation rate {} Hz.\n\n",
@@ -247,5 +285,18 @@ fn report(rows: &[Row], methods: &[String], args: &FidelityArgs) -> String {
     s += "\nA dash: the run did not ring down (fewer than three crossings, or fewer than three peaks above \
           5 % of the largest, or peaks that do not decay as one exponential: fit R² under 0.7). A stateless \
           method's damping ratio reads the envelope of its noise bands, not a ring-down.\n";
+    s += "\n## Neighbours\n\n";
+    s += "Each species' reference tree and copies of it across the mean wind and downwind, each simulated on \
+          its own in `gusty`: the correlation of the trunk tops' downwind motion. Field expectation: it falls with \
+          distance, faster across the wind than along it (gusts are longer than wide), and a downwind neighbour \
+          follows by about the distance over the mean wind speed (frozen turbulence).\n\n";
+    s += "| species | method | distance, m | across: correlation | downwind: largest correlation | at lag, s | distance / U, s |\n";
+    s += "| --- | --- | ---: | ---: | ---: | ---: | ---: |\n";
+    for r in near {
+        s += &format!(
+            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} |\n",
+            r.species, r.method, r.distance, r.crosswind, r.downwind, r.lag, r.frozen_lag
+        );
+    }
     s
 }

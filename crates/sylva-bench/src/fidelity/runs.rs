@@ -7,7 +7,7 @@ use rustfft::{FftPlanner, num_complex::Complex};
 use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::methods::{Animator, MethodOptions};
-use sylva_core::physics::measure::{damping_ratio, sway_frequency};
+use sylva_core::physics::measure::{damping_ratio, ringdown_frequency};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::{Constant, WindField, WindScene};
 
@@ -153,7 +153,7 @@ pub fn measure(
     anim.set_wind(Arc::new(WindScene::default().packed()));
     let ring = record(&mut *anim, dt, p.ring, dx);
     let peak = ring.iter().fold(0.0f32, |a, v| a.max(v.abs()));
-    let frequency = sway_frequency(&ring, dt);
+    let frequency = ringdown_frequency(&ring, dt, 0.0, 0.05 * peak);
     let damping_still = damping_ratio(&ring, 0.0, 0.05 * peak);
     // Step responses.
     let mut steps = Vec::new();
@@ -212,4 +212,131 @@ pub fn measure(
         sway_percent: 100.0 * var.sqrt() / height,
         flutter: flutter.map(|(hi, all)| (all > 0.0).then(|| hi / all)),
     })
+}
+
+/// Separations of the neighbour runs, m.
+pub const NEIGHBOUR_DISTANCES: [f32; 4] = [2.0, 5.0, 10.0, 20.0];
+
+/// How far apart a gust's arrival may be read, s (the largest lag tried).
+const MAX_LAG: f32 = 6.0;
+
+/// How one tree's sway goes with a neighbour's in gusty wind.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct NeighbourRow {
+    /// Species.
+    pub species: String,
+    /// Method.
+    pub method: String,
+    /// Separation, m.
+    pub distance: f32,
+    /// Correlation of the two trunk tops' downwind motion, the neighbour across the mean
+    /// wind (no lag).
+    pub crosswind: f32,
+    /// Largest correlation over lags up to 6 s, the neighbour downwind.
+    pub downwind: f32,
+    /// The lag of that largest correlation, s (positive: the downwind tree follows).
+    pub lag: f32,
+    /// The lag frozen turbulence predicts: the separation over the mean wind speed, s.
+    pub frozen_lag: f32,
+}
+
+/// Pearson correlation of `a[i]` with `b[i + lag]` over their overlap.
+fn correlation(a: &[f32], b: &[f32], lag: isize) -> f32 {
+    let pairs: Vec<(f64, f64)> = (0..a.len() as isize)
+        .filter_map(|i| {
+            let j = i + lag;
+            (j >= 0 && (j as usize) < b.len()).then(|| (a[i as usize] as f64, b[j as usize] as f64))
+        })
+        .collect();
+    let n = pairs.len().max(1) as f64;
+    let (ma, mb) = (pairs.iter().map(|p| p.0).sum::<f64>() / n, pairs.iter().map(|p| p.1).sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in &pairs {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    if saa > 0.0 && sbb > 0.0 { (sab / (saa * sbb).sqrt()) as f32 } else { 0.0 }
+}
+
+/// The trunk top's motion along `along` in the `gusty` preset, after the first 10 s.
+fn gusty_series(
+    registry: &sylva_runtime::MethodRegistry,
+    method: &str,
+    tree: Arc<Tree>,
+    p: Protocol,
+    dt: f32,
+    along: Vec3,
+) -> Result<Vec<f32>> {
+    let t = tree.clone();
+    let mut anim = registry.cpu(method, tree, &MethodOptions::default())?;
+    let top = (t.stems.first_segment[0] + t.stems.segment_count[0] - 1) as usize;
+    let rest = t.segments.end(top);
+    anim.set_wind(Arc::new(WindScene::resolve("gusty")?.packed()));
+    anim.reset(0.0);
+    let x = record(&mut *anim, dt, p.gusty, |pose| (pose.end(&t, top) - rest).dot(along));
+    let skip = ((10.0 / dt) as usize).min(x.len() / 2);
+    Ok(x[skip..].to_vec())
+}
+
+/// Neighbours of `tree` at [`NEIGHBOUR_DISTANCES`] across and along the `gusty` preset's mean
+/// wind, each simulated on its own by `method`: how their sway correlates with the tree's.
+pub fn neighbours(
+    registry: &sylva_runtime::MethodRegistry,
+    method: &str,
+    species: &str,
+    tree: Arc<Tree>,
+    p: Protocol,
+    dt: f32,
+) -> Result<Vec<NeighbourRow>> {
+    let (direction, speed) = WindScene::resolve("gusty")?
+        .fields
+        .iter()
+        .find_map(|f| match f {
+            WindField::Constant(c) => Some((Vec3::from_array(c.direction), c.speed)),
+            _ => None,
+        })
+        .context("the gusty preset has no mean wind")?;
+    let down = Vec3::new(direction.x, 0.0, direction.z).normalize();
+    let across = Vec3::Y.cross(down);
+    let here = gusty_series(registry, method, tree.clone(), p, dt, down)?;
+    let lags = (MAX_LAG / dt) as isize;
+    let mut rows = Vec::new();
+    for distance in NEIGHBOUR_DISTANCES {
+        let there = |offset: Vec3| gusty_series(registry, method, Arc::new(tree.translated(offset)), p, dt, down);
+        let crosswind = correlation(&here, &there(across * distance)?, 0);
+        let downwind = there(down * distance)?;
+        let (lag, best) = (-lags..=lags)
+            .map(|k| (k, correlation(&here, &downwind, k)))
+            .fold((0, f32::MIN), |b, c| if c.1 > b.1 { c } else { b });
+        rows.push(NeighbourRow {
+            species: species.to_string(),
+            method: method.to_string(),
+            distance,
+            crosswind,
+            downwind: best,
+            lag: lag as f32 * dt,
+            frozen_lag: distance / speed,
+        });
+    }
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::correlation;
+
+    /// A series correlates fully with itself, not at all with its quadrature, and a delayed
+    /// copy is found at its delay.
+    #[test]
+    fn correlation_finds_a_delay() {
+        let a: Vec<f32> = (0..2000).map(|k| (k as f32 * 0.05).sin() + (k as f32 * 0.173).cos()).collect();
+        assert!((correlation(&a, &a, 0) - 1.0).abs() < 1e-6);
+        let delayed: Vec<f32> = (0..2000).map(|k| if k >= 30 { a[k - 30] } else { 0.0 }).collect();
+        let best = (-60..=60).max_by(|&x, &y| correlation(&a, &delayed, x).total_cmp(&correlation(&a, &delayed, y)));
+        assert_eq!(best, Some(30));
+        let q: Vec<f32> = (0..20000).map(|k| (k as f32 * 0.05).cos()).collect();
+        let s: Vec<f32> = (0..20000).map(|k| (k as f32 * 0.05).sin()).collect();
+        assert!(correlation(&s, &q, 0).abs() < 0.01);
+    }
 }

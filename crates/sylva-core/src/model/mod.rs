@@ -274,6 +274,15 @@ impl Tree {
         }
     }
 
+    /// The same tree moved by `offset` (m): a neighbour standing elsewhere in the same wind.
+    pub fn translated(&self, offset: Vec3) -> Tree {
+        let mut t = self.clone();
+        t.segments.start.iter_mut().for_each(|p| *p += offset);
+        t.stems.bezier.iter_mut().flatten().for_each(|p| *p += offset);
+        t.leaves.position.iter_mut().for_each(|p| *p += offset);
+        t
+    }
+
     /// Axis-aligned bounds of segment joints and leaf tips.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::splat(f32::INFINITY);

@@ -20,6 +20,27 @@ pub fn sway_frequency(series: &[f32], dt: f32) -> Option<f32> {
     Some(((crossings.len() - 1) as f64 / (span * dt as f64)) as f32)
 }
 
+/// Frequency of an oscillation ringing down about `centre`, Hz: crossings of `centre` (both
+/// ways, half a period apart) while the motion is still above `floor` (a heavily damped
+/// ring-down soon sinks into rounding, where crossings of a mean carry no period). `None`
+/// with fewer than three crossings.
+pub fn ringdown_frequency(series: &[f32], dt: f32, centre: f32, floor: f32) -> Option<f32> {
+    let end = series.iter().rposition(|&x| (x - centre).abs() > floor)? + 1;
+    let live = &series[..(end + 1).min(series.len())];
+    let mut crossings = Vec::new();
+    for k in 1..live.len() {
+        let (a, b) = (live[k - 1] as f64 - centre as f64, live[k] as f64 - centre as f64);
+        if (a < 0.0) != (b < 0.0) {
+            crossings.push((k - 1) as f64 + a / (a - b));
+        }
+    }
+    if crossings.len() < 3 {
+        return None;
+    }
+    let span = crossings[crossings.len() - 1] - crossings[0];
+    Some(((crossings.len() - 1) as f64 / (2.0 * span * dt as f64)) as f32)
+}
+
 /// Damping ratio of a decaying oscillation about `centre`, from the logarithmic decrement
 /// of successive peaks of |x − centre| (a half-period apart): the slope of ln(peak) against
 /// the peak's number, fitted over every peak above `floor`, is −δ/2, and
@@ -71,6 +92,16 @@ mod tests {
         let x: Vec<f32> = (0..6000).map(|k| k as f32 * dt).map(|t| (-zeta * w * t).exp() * (wd * t).cos()).collect();
         let fm = sway_frequency(&x, dt).unwrap();
         assert!((fm / (wd / std::f32::consts::TAU) - 1.0).abs() < 0.01, "{fm}");
+        // A heavily damped ring-down: its mean sits off zero, so the crossings of the rest
+        // position tell its period.
+        let wh = w * (1.0f32 - 0.25 * 0.25).sqrt();
+        let heavy: Vec<f32> =
+            (0..6000).map(|k| k as f32 * dt).map(|t| (-0.25 * w * t).exp() * (wh * t).cos()).collect();
+        let fr = ringdown_frequency(&heavy, dt, 0.0, 0.01).unwrap();
+        assert!((fr / (wh / std::f32::consts::TAU) - 1.0).abs() < 0.005, "{fr}");
+        // The mean's crossings read it several per cent low.
+        let fm = sway_frequency(&heavy, dt).map_or(0.0, |f| f / (wh / std::f32::consts::TAU));
+        assert!((fm - 1.0).abs() > 0.02, "{fm}");
         let z = damping_ratio(&x, 0.0, 0.01).unwrap();
         assert!((z / zeta - 1.0).abs() < 0.05, "{z}");
         let driven: Vec<f32> =

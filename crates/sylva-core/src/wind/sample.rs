@@ -105,6 +105,57 @@ pub fn wind_at(fields: &[RawField], waves: &[RawWave], p: Vec3, t: f32) -> Vec3 
     v
 }
 
+/// The wind at `p` and `t` with each wave (sum of sines, turbulence) passed through a linear
+/// filter: `response(f)` gives the gain and the phase lag (rad) at `f` Hz. A sharpened sum of
+/// sines keeps its mean and filters what swings about it. Fields without waves pass through
+/// as they are. With `response` = (1, 0) it is [`wind_at`] (to rounding).
+pub fn wind_through(
+    fields: &[RawField],
+    waves: &[RawWave],
+    p: Vec3,
+    t: f32,
+    response: impl Fn(f32) -> (f32, f32),
+) -> Vec3 {
+    let mut v = Vec3::ZERO;
+    for f in fields {
+        let run = || &waves[f.wave_offset as usize..(f.wave_offset + f.wave_count) as usize];
+        v += match f.kind {
+            kind::SUM_OF_SINES => {
+                let (sharp, mode) = (f.a[0], f.a[1]);
+                // Mean of ((sin + 1) / 2)^sharp over a period (midpoint rule, exact to ~1e-6).
+                let mean = if mode < 0.5 {
+                    0.0
+                } else {
+                    (0..64).map(|j| ((((j as f32 + 0.5) * TAU / 64.0).sin() + 1.0) * 0.5).powf(sharp)).sum::<f32>()
+                        / 64.0
+                };
+                let mut sum = Vec3::ZERO;
+                for w in run() {
+                    let (gain, lag) = response(w.k[3].abs() / TAU);
+                    let th = v3(w.k).dot(p) + w.k[3] * t - lag * w.k[3].signum();
+                    let s = th.sin();
+                    let h = if mode < 0.5 { s } else { ((s + 1.0) * 0.5).powf(sharp) - mean };
+                    sum += v3(w.dir) * (mean + gain * h);
+                }
+                sum
+            }
+            kind::TURBULENCE => {
+                let mut sum = Vec3::ZERO;
+                for w in run() {
+                    let (gain, lag) = response(w.k[3]);
+                    let cyc = w.k[3] * t + w.phase[0];
+                    let cyc = cyc - cyc.floor();
+                    let th = TAU * cyc - v3(w.k).dot(p) - lag;
+                    sum += v3(w.dir) * (gain * th.sin());
+                }
+                sum
+            }
+            _ => field_at(f, waves, p, t),
+        };
+    }
+    v
+}
+
 /// The kernel's CPU twin. Bindings as in `wind_sample.wgsl`: 0 = fields, 1 = waves,
 /// 2 = samples (x, y, z, t), 3 = velocities (x, y, z, 0).
 pub fn wind_sample(fields: &[RawField], waves: &[RawWave], samples: &[[f32; 4]], out: &mut [[f32; 4]]) {

@@ -2,10 +2,11 @@
 //!
 //! Stateless: the pose at time t is a function of (tree, wind, t) alone.
 //!
-//! * **Trunk** (§6.3.3): the trunk noise bands of [`trunk`] for the wind speed
-//!   at the crown's centre at time t give angles parallel to the wind (about `up × w`),
-//!   perpendicular (about `w`) and a twist (about `up`), spread over the trunk's segments in
-//!   proportion to their length.
+//! * **Trunk** (§6.3.3, Ota 2003): the wind at the crown's centre passed wave by wave through
+//!   a damped oscillator at the trunk's own frequency ([`trunk`]); the trunk leans by that
+//!   wind's static bend along it (about `up × w`), with small-branch chaos bands parallel,
+//!   perpendicular (about `w`) and as a twist (about `up`), spread over the trunk's segments
+//!   in proportion to their length.
 //! * **Branches** (§6.3.3, Listing 6-1): each stem samples the wind at its base. Its
 //!   horizontal direction `b` against the wind direction `w` weighs three cases,
 //!   `facing = max(0, −b·w)`, `back = max(0, b·w)`, `perpendicular = 1 − |b·w|`:
@@ -36,9 +37,10 @@ use crate::wind::PackedWind;
 use crate::wind::WindScene;
 use crate::wind::raw::{RawField, RawWave};
 use glam::Vec3;
+use rayon::prelude::*;
 use rotations::zioma_rotations;
 use std::sync::Arc;
-use trunk::TrunkNoise;
+use trunk::{TrunkModel, TrunkNoise};
 
 /// Simulation level of detail (§6.5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
@@ -112,6 +114,8 @@ pub struct Zioma {
     pub stems: Vec<RawZiomaStem>,
     /// Point where the trunk's wind is sampled (crown centre), m.
     pub crown_centre: Vec3,
+    /// The trunk's frequency, static bend and damping (the shared physical description).
+    pub trunk: TrunkModel,
     tree_seed: u32,
     raw: Vec<crate::model::RawSegment>,
 }
@@ -151,19 +155,19 @@ impl Zioma {
             0.5 * (lo.y + hi.y) + 0.25 * (hi.y - lo.y),
             tree.segments.start.first().map_or(0.0, |p| p.z),
         );
-        Self { params, stems, crown_centre, tree_seed: mix64(params.seed) as u32, raw: tree.raw_segments() }
+        let trunk = TrunkModel::for_tree(tree, crate::physics::BRANCH_DRAG, crate::physics::LEAF_DRAG);
+        Self { params, stems, crown_centre, trunk, tree_seed: mix64(params.seed) as u32, raw: tree.raw_segments() }
     }
 
     /// The per-frame values at time `t`: wind at the crown, trunk angles and their rate (the
     /// tree at the origin, unturned).
-    pub fn frame(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], t: f32) -> RawZiomaFrame {
-        self.frame_for(tree, fields, waves, t, None)
+    pub fn frame(&self, fields: &[RawField], waves: &[RawWave], t: f32) -> RawZiomaFrame {
+        self.frame_for(fields, waves, t, None)
     }
 
     /// The per-frame values of one instance (`None`: the tree at the origin, unturned).
     pub fn frame_for(
         &self,
-        tree: &Tree,
         fields: &[RawField],
         waves: &[RawWave],
         t: f32,
@@ -173,15 +177,18 @@ impl Zioma {
             Some(i) => (i.to_world(self.crown_centre), self.tree_seed ^ i.seed),
             None => (self.crown_centre, self.tree_seed),
         };
-        let v = crate::wind::sample::wind_at(fields, waves, centre, t);
-        let v = instance.map_or(v, |i| i.to_local(v));
-        let h = Vec3::new(v.x, 0.0, v.z);
-        let u = h.length();
-        let dir = if u > 1e-6 { h / u } else { Vec3::ZERO };
-        let noise = TrunkNoise::for_tree(tree, u);
+        // The trunk's lean (its oscillator's answer to the wind, horizontal, in the tree's
+        // frame), with chaos bands on top.
+        let lean = |t: f32| {
+            let b = self.trunk.bend(fields, waves, centre, t);
+            let b = instance.map_or(b, |i| i.to_local(b));
+            let theta = b.length().min(trunk::MAX_TRUNK_BEND);
+            (b.try_normalize().unwrap_or(Vec3::ZERO), TrunkNoise::new(self.trunk.natural_frequency, theta))
+        };
+        let (dir, noise) = lean(t);
         let a = noise.angles(t, seed);
         let dt = 0.01;
-        let rate = (noise.angles(t + dt, seed)[0] - noise.angles(t - dt, seed)[0]) / (2.0 * dt);
+        let rate = (lean(t + dt).1.angles(t + dt, seed)[0] - lean(t - dt).1.angles(t - dt, seed)[0]) / (2.0 * dt);
         let (sin, cos) = instance.map_or((0.0, 1.0), |i| i.yaw.sin_cos());
         RawZiomaFrame {
             wind_dir: dir.to_array(),
@@ -199,6 +206,17 @@ impl Zioma {
         }
     }
 
+    /// The per-frame values of every instance (in parallel; each on its own).
+    pub fn frames_for(
+        &self,
+        fields: &[RawField],
+        waves: &[RawWave],
+        t: f32,
+        instances: &[ZiomaInstance],
+    ) -> Vec<RawZiomaFrame> {
+        instances.par_iter().map(|i| self.frame_for(fields, waves, t, Some(i))).collect()
+    }
+
     /// Per-segment rotations δ of every instance at time `t`, instance by instance
     /// (`instances.len() × segments`), all in one parallel pass (CPU reference).
     pub fn rotations_instances(
@@ -209,8 +227,7 @@ impl Zioma {
         t: f32,
         instances: &[ZiomaInstance],
     ) -> Vec<[f32; 4]> {
-        let frames: Vec<RawZiomaFrame> =
-            instances.iter().map(|i| self.frame_for(tree, fields, waves, t, Some(i))).collect();
+        let frames = self.frames_for(fields, waves, t, instances);
         let mut out = vec![[0.0; 4]; tree.segments.len() * instances.len()];
         zioma_rotations(fields, waves, &self.raw, &self.stems, &frames, &mut out);
         out
@@ -224,7 +241,7 @@ impl Zioma {
 
     /// [`Self::rotations`] with a scene packed once by the caller.
     pub fn rotations_packed(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], t: f32) -> Vec<[f32; 4]> {
-        let frame = self.frame(tree, fields, waves, t);
+        let frame = self.frame(fields, waves, t);
         let mut out = vec![[0.0; 4]; tree.segments.len()];
         zioma_rotations(fields, waves, &self.raw, &self.stems, &[frame], &mut out);
         out

@@ -1,30 +1,40 @@
-//! Trunk motion as superposed noise bands (Zioma §6.3.3, Figs. 6-2 and 6-3).
+//! Trunk motion (Zioma §6.3.3, Figs. 6-2 and 6-3) as the response of a damped oscillator
+//! (Ota 2003's `m a + c v + k x = f`, which the chapter cites) at the trunk's own frequency,
+//! without state: the wind at the crown is passed through the oscillator's transfer function
+//! wave by wave, each of its waves (sum of sines, turbulence) scaled by
+//! `|H(f)| = 1 / √((1 − r²)² + (2ζr)²)`, `r = f / f₀`, and delayed by its phase
+//! `atan2(2ζr, 1 − r²)`: the steady response of `ẍ + 2ζω₀ẋ + ω₀²x = ω₀² u` to a sum of sines,
+//! exactly. The trunk leans by the static bend of the wind as it is (drag is quadratic in
+//! it) plus the oscillator's answer to the waves' swings, linearised about that bend
+//! ([`TrunkModel::bend`]). Its constants come from the shared physical description
+//! ([`TrunkModel`], [`crate::physics`]):
 //!
-//! Instead of integrating `m a + c v + k x = f`, the trunk's bend is synthesised from
-//! frequency bands whose amplitudes and frequencies come from the tree itself:
+//! * the **natural frequency** f₀ of the trunk's first mode, the continuous tapered
+//!   cantilever's ([`crate::physics::stem_frequencies`]);
+//! * the **static bend** under the sheltered crown's drag, the same beam's tip deflection
+//!   per pascal ([`crate::physics::beam::drag_bend`]) times `½ ρ U² g(U)` (Vogel
+//!   reconfiguration, [`DragModel`]), spread over the trunk as an arc whose top moves by
+//!   that deflection δ ([`TrunkModel::lever`]);
+//! * the **damping ratio**: the wood's ([`STRUCTURAL_DAMPING`]) plus the air's, from the
+//!   drag on the moving crown at its centre of pressure, so it rises with the wind.
 //!
-//! * the **natural frequency** of the trunk as a tapered cantilever,
-//!   `f₀ = 0.7 · (1.875² / 2π) · √(E I / (ρ A)) / H²` with the trunk's base radius
-//!   (`I/A = r²/4`), height H, the wood's E and ρ; the factor 0.7 accounts for taper and
-//!   the crown's mass, bringing typical trees to the 0.2–0.6 Hz that field measurements report;
-//! * the **static bend** under the crown's drag, `θ = F h² / (2 E I)` with
-//!   `F = ½ ρ_air C_d A_crown U²` acting at the crown's mid-height h (a cantilever's end
-//!   rotation under a point load), capped at 0.35 rad.
-//!
-//! Bands (multiples of f₀ and of θ): *parallel* to the wind — a lean of 0.8 θ plus slow gust
-//! response (0.15 f₀, 0.3 θ), sway at the natural frequency (f₀, 0.4 θ), and small-branch
-//! chaos (2.3 f₀, 0.12 θ; 5.1 f₀, 0.05 θ); *perpendicular* — (0.9 f₀, 0.2 θ),
-//! (3.1 f₀, 0.06 θ); *twist* about the trunk axis — (1.3 f₀, 0.08 θ). A heavier, stiffer
-//! tree gets a lower f₀ and a smaller θ: lower amplitude and frequency, as in Fig. 6-3.
+//! Fields without waves (constant, gust front, vortex, blast) pass through unfiltered
+//! (quasi-statically): a tree does not ring after a gust front or when the wind stops, which
+//! would need state. Small-branch chaos rides on top as noise bands (multiples of f₀, scaled
+//! by θ): parallel (2.3 f₀, 0.12 θ; 5.1 f₀, 0.05 θ), perpendicular (3.1 f₀, 0.06 θ) and a
+//! twist (1.3 f₀, 0.08 θ). A heavier, stiffer tree gets a lower f₀ and a smaller θ: lower
+//! amplitude and frequency, as in Fig. 6-3.
 
 use crate::model::Tree;
-use crate::physics::AIR_DENSITY;
+use crate::physics::{AIR_DENSITY, DragModel, STRUCTURAL_DAMPING};
 use crate::wind::noise::value_noise;
+use crate::wind::raw::{RawField, RawWave};
 use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
 use rayon::prelude::*;
 
-/// Drag coefficient of a tree crown (porous: 0.2–0.4 in wind-tunnel studies).
-pub const CROWN_DRAG: f32 = 0.3;
+/// Largest trunk bend, rad (≈ 20°: beyond it an arc is a poor picture of a bent trunk).
+pub const MAX_TRUNK_BEND: f32 = 0.35;
 
 /// Axis a band moves: 0 parallel to the wind, 1 perpendicular, 2 twist.
 #[repr(C)]
@@ -44,36 +54,138 @@ pub struct RawBand {
     pub _pad: [u32; 3],
 }
 
+/// A tree's trunk as the shared physical description sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrunkModel {
+    /// First-mode frequency f₀, Hz.
+    pub natural_frequency: f32,
+    /// Trunk-top deflection per pascal of dynamic pressure on the crown, m/Pa.
+    pub tip_per_pascal: f32,
+    /// Centre of pressure: the share of the tip's motion where the drag acts.
+    pub pressure_centre: f32,
+    /// How far the trunk top moves per radian of arc, m: `Σ Lᵢ cᵢ` over the trunk's
+    /// segments, `cᵢ` the share of the trunk's length up to segment i's end (each segment
+    /// turns by its share of the arc; L/2 for a smooth arc).
+    pub lever: f32,
+    /// Structural damping ratio.
+    pub damping_ratio: f32,
+    /// Drag and reconfiguration.
+    pub drag: DragModel,
+}
+
+impl TrunkModel {
+    /// The model of `tree`'s first stem, with bark drag `bark_drag` and leaf drag
+    /// `leaf_drag` (per one-sided area) sheltered as [`crate::physics::crown_shelter`] says.
+    pub fn for_tree(tree: &Tree, bark_drag: f32, leaf_drag: f32) -> Self {
+        if tree.stems.is_empty() || tree.stems.segment_count[0] == 0 {
+            let drag = DragModel::default();
+            return Self {
+                natural_frequency: 1.0,
+                tip_per_pascal: 0.0,
+                pressure_centre: 0.5,
+                lever: 1.0,
+                damping_ratio: STRUCTURAL_DAMPING,
+                drag,
+            };
+        }
+        let min_radius = crate::physics::MIN_RADIUS;
+        let modes = crate::physics::stem_frequencies(tree, min_radius);
+        let shelter = crate::physics::crown_shelter(tree, bark_drag, leaf_drag);
+        let cd_area = crate::physics::beam::drag_areas(tree, bark_drag, leaf_drag, shelter);
+        let bend = crate::physics::beam::drag_bend(tree, min_radius, &cd_area);
+        let (first, n) = (tree.stems.first_segment[0] as usize, tree.stems.segment_count[0] as usize);
+        let lengths = &tree.segments.length[first..first + n];
+        let total: f32 = lengths.iter().sum::<f32>().max(1e-6);
+        let mut along = 0.0;
+        let lever = lengths
+            .iter()
+            .map(|l| {
+                along += l;
+                l * along / total
+            })
+            .sum::<f32>()
+            .max(1e-6);
+        Self {
+            natural_frequency: modes.hz(0),
+            tip_per_pascal: bend.tip[0],
+            pressure_centre: bend.pressure_centre[0],
+            lever,
+            damping_ratio: STRUCTURAL_DAMPING,
+            drag: DragModel::default(),
+        }
+    }
+
+    /// Arc angle θ of the trunk under a steady wind of `u` m/s, rad (capped at
+    /// [`MAX_TRUNK_BEND`]).
+    pub fn static_bend(&self, u: f32) -> f32 {
+        let q = 0.5 * AIR_DENSITY * u * u * self.drag.reconfiguration(u);
+        (self.tip_per_pascal * q / self.lever).min(MAX_TRUNK_BEND)
+    }
+
+    /// Damping ratio in a wind of `u` m/s: the wood's plus the air's, `ω₀ c ρ δ' u g(u) / 2`
+    /// (δ' the tip's deflection per pascal, c the centre of pressure), as Skjermo's stems.
+    pub fn damping(&self, u: f32) -> f32 {
+        let w = std::f32::consts::TAU * self.natural_frequency;
+        self.damping_ratio
+            + 0.5 * w * self.pressure_centre * AIR_DENSITY * self.tip_per_pascal * u * self.drag.reconfiguration(u)
+    }
+
+    /// The oscillator's response to a wave of `f` Hz at damping ratio `zeta`: gain and
+    /// phase lag (rad).
+    pub fn response(&self, f: f32, zeta: f32) -> (f32, f32) {
+        let r = f.abs() / self.natural_frequency.max(1e-6);
+        let (re, im) = (1.0 - r * r, 2.0 * zeta * r);
+        (1.0 / (re * re + im * im).sqrt().max(1e-6), im.atan2(re))
+    }
+
+    /// d θ / d u at a steady wind of `u` m/s (0 where the bend is capped).
+    pub fn static_bend_slope(&self, u: f32) -> f32 {
+        if self.static_bend(u) >= MAX_TRUNK_BEND {
+            return 0.0;
+        }
+        let d = &self.drag;
+        let ur2 = d.reconfiguration_speed * d.reconfiguration_speed;
+        let slope = u * d.reconfiguration(u) * (2.0 + d.vogel_exponent * u * u / (ur2 + u * u));
+        self.tip_per_pascal * 0.5 * AIR_DENSITY * slope / self.lever
+    }
+
+    /// The trunk's bend at `p` and `t` as a horizontal vector, rad along the direction it
+    /// leans: the static bend of the wind as it is (drag is quadratic), plus the oscillator's
+    /// answer to its swings, linearised about it. The waves' swings `δ = u_H − u` (`u_H` the
+    /// wind through [`Self::response`] at the damping of the wind's speed) push along the
+    /// wind by `θ'(u) δ∥` and turn the push by `θ(u) δ⊥ / u`.
+    pub fn bend(&self, fields: &[RawField], waves: &[RawWave], p: Vec3, t: f32) -> Vec3 {
+        let horizontal = |v: Vec3| Vec3::new(v.x, 0.0, v.z);
+        let raw = horizontal(crate::wind::sample::wind_at(fields, waves, p, t));
+        let u = raw.length();
+        if u < 1e-6 {
+            return Vec3::ZERO;
+        }
+        let zeta = self.damping(u);
+        let through = horizontal(crate::wind::sample::wind_through(fields, waves, p, t, |f| self.response(f, zeta)));
+        let (along, across) = (raw / u, Vec3::Y.cross(raw / u));
+        let swing = through - raw;
+        let theta = self.static_bend(u);
+        along * (theta + self.static_bend_slope(u) * swing.dot(along)) + across * (theta * swing.dot(across) / u)
+    }
+}
+
 /// The noise bands of one tree in one wind.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrunkNoise {
     /// Natural frequency f₀, Hz.
     pub natural_frequency: f32,
-    /// Static bend θ under the mean wind, rad.
+    /// Static bend θ, rad.
     pub static_bend: f32,
     /// The bands.
     pub bands: Vec<RawBand>,
 }
 
 impl TrunkNoise {
-    /// Bands for a tree with trunk base radius `radius` (m), height `height` (m), crown area
-    /// `crown_area` (m²) centred at `crown_height` (m), wood E (Pa) and ρ (kg/m³), in a mean
-    /// wind of `wind_speed` (m/s).
-    pub fn new(
-        radius: f32,
-        height: f32,
-        crown_area: f32,
-        crown_height: f32,
-        young: f32,
-        density: f32,
-        wind_speed: f32,
-    ) -> Self {
-        let r = radius.max(1e-4);
-        let h = height.max(0.1);
-        let ei = young * std::f32::consts::FRAC_PI_4 * r.powi(4);
-        let f0 = 0.7 * (1.875f32 * 1.875 / std::f32::consts::TAU) * (young * r * r / (4.0 * density)).sqrt() / (h * h);
-        let force = 0.5 * AIR_DENSITY * CROWN_DRAG * crown_area * wind_speed * wind_speed;
-        let theta = (force * crown_height * crown_height / (2.0 * ei)).min(0.35);
+    /// Small-branch chaos about a trunk of frequency `natural_frequency` (Hz) bent by
+    /// `static_bend` (rad): the lean itself as the first band's bias.
+    pub fn new(natural_frequency: f32, static_bend: f32) -> Self {
+        let (f0, theta) = (natural_frequency, static_bend);
         let band = |axis: u32, seed: u32, fr: f32, amp: f32, bias: f32| RawBand {
             axis,
             seed,
@@ -83,51 +195,12 @@ impl TrunkNoise {
             _pad: [0; 3],
         };
         let bands = vec![
-            band(0, 0x11, 0.15, 0.3, 0.8),
-            band(0, 0x12, 1.0, 0.4, 0.0),
-            band(0, 0x13, 2.3, 0.12, 0.0),
+            band(0, 0x13, 2.3, 0.12, 1.0),
             band(0, 0x14, 5.1, 0.05, 0.0),
-            band(1, 0x21, 0.9, 0.2, 0.0),
             band(1, 0x22, 3.1, 0.06, 0.0),
             band(2, 0x31, 1.3, 0.08, 0.0),
         ];
         Self { natural_frequency: f0, static_bend: theta, bands }
-    }
-
-    /// Bands for a generated tree: the trunk radius at 40 % of the first stem's length (above
-    /// the flare, where a tapered trunk bends), height and crown from its bounds (the crown
-    /// spans from the lowest branch to the top).
-    pub fn for_tree(tree: &Tree, wind_speed: f32) -> Self {
-        let s = &tree.segments;
-        let mut radius = s.radius_base.first().copied().unwrap_or(0.05);
-        if !tree.stems.is_empty() {
-            let (first, n) = (tree.stems.first_segment[0] as usize, tree.stems.segment_count[0] as usize);
-            let target = 0.4 * tree.stems.length[0];
-            let mut acc = 0.0;
-            for i in first..first + n {
-                if acc + s.length[i] >= target {
-                    let f = ((target - acc) / s.length[i]).clamp(0.0, 1.0);
-                    radius = s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * f;
-                    break;
-                }
-                acc += s.length[i];
-            }
-        }
-        let (lo, hi) = tree.bounds();
-        let height = hi.y - lo.y;
-        let crown_base = (0..s.len()).filter(|&i| s.level[i] > 0).map(|i| s.start[i].y).fold(f32::INFINITY, f32::min);
-        let crown_base = if crown_base.is_finite() { crown_base } else { lo.y + 0.5 * height };
-        let crown_h = (hi.y - crown_base).max(0.1);
-        let width = (hi.x - lo.x).max(hi.z - lo.z).max(0.1);
-        Self::new(
-            radius,
-            height,
-            crown_h * width,
-            0.5 * (crown_base + hi.y) - lo.y,
-            tree.wood.young_modulus,
-            tree.wood.density,
-            wind_speed,
-        )
     }
 
     /// (parallel, perpendicular, twist) at time `t` for a tree with phase seed `tree_seed`.

@@ -68,15 +68,15 @@ impl GpuZioma {
     }
 
     /// Records and submits every instance's pose at time `t` without reading it back (the
-    /// per-instance frame values are computed on the CPU: one wind sample and the trunk
+    /// per-instance frame values are computed on the CPU: the trunk's filtered wind and its
     /// bands each).
     pub fn submit(&mut self, ctx: &GpuContext, t: f32) {
         self.time = t;
-        let (tree, m, w) = (&*self.tree, &self.method, &*self.wind.packed);
+        let (m, w) = (&self.method, &*self.wind.packed);
         let frames: Vec<RawZiomaFrame> = if self.instances.is_empty() {
-            vec![m.frame(tree, &w.fields, &w.waves, t)]
+            vec![m.frame(&w.fields, &w.waves, t)]
         } else {
-            self.instances.iter().map(|i| m.frame_for(tree, &w.fields, &w.waves, t, Some(i))).collect()
+            m.frames_for(&w.fields, &w.waves, t, &self.instances)
         };
         ctx.queue.write_buffer(&self.frame, 0, bytemuck::cast_slice(&frames));
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
