@@ -34,7 +34,8 @@ pub struct RawZiomaStem {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawZiomaFrame {
-    /// Horizontal unit wind direction at the crown (zero in calm air).
+    /// Horizontal unit direction the trunk leans toward (the wind's at the crown, turned by
+    /// the oscillator's answer to its swings; zero in calm air).
     pub wind_dir: [f32; 3],
     /// Time, s.
     pub time: f32,
