@@ -19,7 +19,7 @@ pub fn atomic_png(
         let root = BitMapBackend::new(pending.tmp(), size).into_drawing_area();
         root.fill(&WHITE)?;
         draw(&root)?;
-        root.present()?;
+        root.present().with_context(|| format!("writing {}", path.display()))?;
     }
     pending.commit().with_context(|| format!("writing {}", path.display()))
 }

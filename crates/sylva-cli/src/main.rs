@@ -5,7 +5,9 @@
 //! With no arguments, runs the main job: `sylva render` on the built-in default scene.
 
 mod export_cmd;
+mod limit_args;
 mod render_cmd;
+mod signals;
 mod simulate_cmd;
 mod view_cmd;
 mod wind_cmd;
@@ -15,9 +17,9 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::time::Instant;
+use sylva_core::Tree;
 use sylva_core::export::{ObjOptions, write_obj};
 use sylva_core::species::{DEFAULT_SPECIES, PRESETS, PresetKind, SpeciesSource};
-use sylva_core::{Limits, Tree};
 
 #[derive(Parser, Debug)]
 #[command(name = "sylva", version, about = "Grow trees and move them in the wind, on the CPU and the GPU.")]
@@ -66,22 +68,48 @@ struct GenerateArgs {
     /// Output OBJ file (default: out/<species>.obj); `-` writes none.
     #[arg(long, short)]
     out: Option<PathBuf>,
-    /// Sides of each branch tube in the OBJ.
-    #[arg(long, default_value_t = 6)]
+    /// Sides of each branch tube in the OBJ (3 to 64, as export and scenes allow).
+    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(3..=64))]
     sides: u32,
-    /// Stop with an error before a tree exceeds this many segments.
-    #[arg(long, default_value_t = Limits::default().max_segments)]
-    max_segments: usize,
-    /// Stop with an error before a tree exceeds this many leaves.
-    #[arg(long, default_value_t = Limits::default().max_leaves)]
-    max_leaves: usize,
-    /// Worker threads (default: all cores). The tree is identical for any count.
-    #[arg(long)]
+    #[command(flatten)]
+    limits: limit_args::LimitArgs,
+    /// Worker threads (default: all cores; at most 4 per core). The tree is identical for
+    /// any count.
+    #[arg(long, value_parser = parse_threads)]
     threads: Option<usize>,
 }
 
-fn main() -> Result<()> {
+fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
+    if let Err(e) = signals::install() {
+        eprintln!("warning: no signal handling ({e}); an interrupt may leave temporary files");
+    }
+    match run(cli) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("Error: {}", report(&e));
+            std::process::ExitCode::from(signals::exit_status().unwrap_or(1))
+        }
+    }
+}
+
+/// The error and its causes, each cause once: a cause whose text its wrapper already quotes
+/// (a file name prefixed to a parse error) is not repeated.
+fn report(e: &anyhow::Error) -> String {
+    let mut out = e.to_string();
+    let mut last = out.clone();
+    for cause in e.chain().skip(1) {
+        let text = cause.to_string();
+        if !last.contains(&text) {
+            out.push_str("\n  caused by: ");
+            out.push_str(&text);
+        }
+        last = text;
+    }
+    out
+}
+
+fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => render_cmd::run(&render_cmd::RenderArgs::default()),
         Some(Command::Render(args)) => render_cmd::run(&args),
@@ -114,6 +142,16 @@ fn main() -> Result<()> {
     }
 }
 
+/// `--threads`: 1 to 4 per core.
+fn parse_threads(s: &str) -> Result<usize, String> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let most = 4 * cores;
+    match s.parse::<usize>() {
+        Ok(n) if (1..=most).contains(&n) => Ok(n),
+        _ => Err(format!("expected 1 to {most} (4 per core; this machine has {cores})")),
+    }
+}
+
 fn presets() {
     println!("{:<18} {:<9} {:<36} description", "name", "kind", "file");
     for p in PRESETS {
@@ -129,10 +167,10 @@ fn presets() {
 
 fn generate(args: GenerateArgs) -> Result<()> {
     if let Some(n) = args.threads {
-        rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global().context("setting up worker threads")?;
+        rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting up worker threads")?;
     }
-    let limits = Limits { max_segments: args.max_segments, max_leaves: args.max_leaves, ..Limits::default() };
-    let source = SpeciesSource::resolve(&args.species)?;
+    let limits = args.limits.limits();
+    let source = SpeciesSource::resolve_with(&args.species, &limits)?;
     let t0 = Instant::now();
     let tree = source.generate(args.seed, &limits, args.iterations)?;
     let elapsed = t0.elapsed();

@@ -9,9 +9,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
-use sylva_core::io::PendingFile;
+use sylva_core::io::{PendingDir, PendingFile};
 use sylva_core::scene::{BackendChoice, Scene};
 use sylva_gpu::GpuContext;
 use sylva_gpu::render::{Camera, Lighting, RenderSettings, Renderer};
@@ -46,6 +45,8 @@ pub struct RenderArgs {
     /// Write no PNG frames.
     #[arg(long)]
     pub no_png: bool,
+    #[command(flatten)]
+    pub limits: crate::limit_args::LimitArgs,
 }
 
 /// Backend override.
@@ -120,6 +121,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if a.no_png {
         scene.output.png = false;
     }
+    scene.limits = a.limits.limits();
     if let Some(b) = a.backend {
         for t in &mut scene.trees {
             t.backend = match b {
@@ -130,18 +132,25 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         }
     }
     scene.check().map_err(|(field, value, expected)| {
-        anyhow::anyhow!("{}: field `{field}` = {value}: expected {expected}", scene.file)
+        // A value from a flag is the flag's fault, not the scene file's.
+        let flag = match field.as_str() {
+            "output.width" if a.width.is_some() => Some("--width"),
+            "output.height" if a.height.is_some() => Some("--height"),
+            "output.seconds" if a.seconds.is_some() => Some("--seconds"),
+            "output.fps" if a.fps.is_some() => Some("--fps"),
+            _ => None,
+        };
+        match flag {
+            Some(flag) => anyhow::anyhow!("{flag} {value}: expected {expected}"),
+            None => anyhow::anyhow!("{}: field `{field}` = {value}: expected {expected}", scene.file),
+        }
     })?;
-    let interrupted = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupted.clone();
-        // A second handler cannot be installed (tests call `run` once per process).
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-    }
-    render(&scene, &interrupted)
+    // Stop between frames on a signal, so that ffmpeg is stopped before its file is removed.
+    crate::signals::graceful();
+    render(&scene)
 }
 
-fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
+fn render(scene: &Scene) -> Result<()> {
     let o = &scene.output;
     let ctx = GpuContext::shared_arc()?;
     println!("GPU: {}", ctx.summary);
@@ -191,18 +200,30 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
     }
 
     std::fs::create_dir_all(&o.dir).with_context(|| format!("creating {}", o.dir.display()))?;
+    // Frames go to a temporary directory and replace the earlier run's only when all are
+    // written: an interrupted or failed render leaves `frames/` as it was.
     let frames_dir = o.dir.join("frames");
-    if o.png {
-        std::fs::create_dir_all(&frames_dir).with_context(|| format!("creating {}", frames_dir.display()))?;
-    }
+    let frames_pending = o
+        .png
+        .then(|| PendingDir::new(&o.dir, "frames"))
+        .transpose()
+        .with_context(|| format!("creating a temporary directory in {}", o.dir.display()))?;
     let frames = scene.frames();
     let gif_path = o.dir.join(format!("{}.gif", o.name));
     let gif_pending = o.gif.then(|| PendingFile::new(&gif_path)).transpose()?;
-    let mut gif = match &gif_pending {
+    // The encoder borrows the writer, so that the writer's flush reports a full disk (the
+    // encoder's drop, which writes the trailer, would swallow it).
+    let mut gif_writer = match &gif_pending {
         Some(p) => {
-            let f = p.create().with_context(|| format!("creating {}", p.tmp().display()))?;
-            let mut enc = image::codecs::gif::GifEncoder::new_with_speed(std::io::BufWriter::new(f), 10);
-            enc.set_repeat(image::codecs::gif::Repeat::Infinite)?;
+            Some(std::io::BufWriter::new(p.create().with_context(|| format!("creating {}", p.tmp().display()))?))
+        }
+        None => None,
+    };
+    let mut gif = match &mut gif_writer {
+        Some(w) => {
+            let mut enc = image::codecs::gif::GifEncoder::new_with_speed(w, 10);
+            enc.set_repeat(image::codecs::gif::Repeat::Infinite)
+                .with_context(|| format!("writing {}", gif_path.display()))?;
             Some(enc)
         }
         None => None,
@@ -241,9 +262,16 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
     let start = Instant::now();
     let (mut sim_s, mut draw_s, mut encode_s) = (0.0f64, 0.0f64, 0.0f64);
     for f in 0..frames {
-        if interrupted.load(Ordering::SeqCst) {
+        if crate::signals::interrupted() {
             bar.abandon();
-            bail!("interrupted after {f} of {frames} frames; no partial animation was written");
+            if let Some(mut child) = ffmpeg.take() {
+                let _ = child.kill();
+                let _ = child.wait();
+            }
+            bail!(
+                "{} after {f} of {frames} frames: stopped; no partial output was written",
+                crate::signals::received().unwrap_or("interrupted")
+            );
         }
         let t0 = Instant::now();
         world.step(if f == 0 && prerolled { 0 } else { steps })?;
@@ -255,15 +283,17 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         let t2 = Instant::now();
         draw_labels(&mut rgba, o.width, o.height, &labels)?;
         let img = image::RgbaImage::from_raw(o.width, o.height, rgba).context("image size")?;
-        if o.png {
-            let path = frames_dir.join(format!("{}_{f:04}.png", o.name));
-            let p = PendingFile::new(&path)?;
-            img.save(p.tmp()).with_context(|| format!("writing {}", p.tmp().display()))?;
-            p.commit().with_context(|| format!("writing {}", path.display()))?;
+        if let Some(dir) = &frames_pending {
+            let path = dir.tmp().join(format!("{}_{f:04}.png", o.name));
+            let mut png = Vec::new();
+            img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+                .context("encoding a PNG frame")?;
+            std::fs::write(&path, &png).with_context(|| format!("writing {}", path.display()))?;
         }
         if let Some(enc) = &mut gif {
             let delay = image::Delay::from_numer_denom_ms(1000, o.fps.round().max(1.0) as u32);
-            enc.encode_frame(image::Frame::from_parts(img.clone(), 0, 0, delay))?;
+            enc.encode_frame(image::Frame::from_parts(img.clone(), 0, 0, delay))
+                .with_context(|| format!("writing {}", gif_path.display()))?;
         }
         if let Some(child) = &mut ffmpeg {
             child.stdin.as_mut().context("ffmpeg stdin")?.write_all(img.as_raw()).context("feeding ffmpeg")?;
@@ -274,10 +304,9 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         bar.inc(1);
     }
     bar.finish_and_clear();
-    if let Some(enc) = gif {
-        drop(enc);
-    }
-    if let Some(p) = gif_pending {
+    drop(gif);
+    if let (Some(w), Some(p)) = (gif_writer, gif_pending) {
+        w.into_inner().map_err(|e| e.into_error()).with_context(|| format!("writing {}", gif_path.display()))?;
         p.commit().with_context(|| format!("writing {}", gif_path.display()))?;
         println!("wrote {}", gif_path.display());
     }
@@ -290,7 +319,14 @@ fn render(scene: &Scene, interrupted: &AtomicBool) -> Result<()> {
         p.commit().with_context(|| format!("writing {}", mp4_path.display()))?;
         println!("wrote {}", mp4_path.display());
     }
-    if o.png {
+    if let Some(dir) = frames_pending {
+        let prefix = format!("{}_", o.name);
+        let stale = |name: &str| {
+            name.strip_prefix(&prefix)
+                .and_then(|r| r.strip_suffix(".png"))
+                .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
+        };
+        dir.commit(&frames_dir, stale).with_context(|| format!("moving the frames into {}", frames_dir.display()))?;
         println!("wrote {} frames to {}", frames, frames_dir.display());
     }
     let n = frames as f64;

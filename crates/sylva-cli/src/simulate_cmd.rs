@@ -7,12 +7,12 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
+use sylva_core::Tree;
 use sylva_core::io::PendingFile;
 use sylva_core::methods::{Animator, MethodOptions};
 use sylva_core::pose::{Pose, displacement};
 use sylva_core::species::{DEFAULT_SPECIES, SpeciesSource};
 use sylva_core::wind::WindScene;
-use sylva_core::{Limits, Tree};
 use sylva_gpu::methods::GpuAnimator;
 use sylva_runtime::{BUILTIN, MethodRegistry};
 
@@ -44,6 +44,8 @@ pub struct TreeWindArgs {
     /// repeat for several. The names are the method's `Params` fields.
     #[arg(long = "param", value_parser = parse_param)]
     pub params: Vec<(String, toml::Value)>,
+    #[command(flatten)]
+    pub limits: crate::limit_args::LimitArgs,
 }
 
 /// `name=value` with a TOML value (a bare word is a string).
@@ -60,7 +62,8 @@ fn parse_param(s: &str) -> Result<(String, toml::Value), String> {
 impl TreeWindArgs {
     /// Generates the tree and loads the wind.
     pub fn resolve(&self) -> Result<(Tree, WindScene)> {
-        let tree = SpeciesSource::resolve(&self.species)?.generate(self.seed, &Limits::default(), None)?;
+        let limits = self.limits.limits();
+        let tree = SpeciesSource::resolve_with(&self.species, &limits)?.generate(self.seed, &limits, None)?;
         Ok((tree, WindScene::resolve(&self.wind)?))
     }
 
@@ -170,7 +173,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
             let mut f = std::io::BufWriter::new(
                 pending.create().with_context(|| format!("creating {}", pending.tmp().display()))?,
             );
-            writeln!(f, "time_s,segment,level,x,y,z,dx,dy,dz")?;
+            writeln!(f, "time_s,segment,level,x,y,z,dx,dy,dz").with_context(|| format!("writing {}", p.display()))?;
             Some((pending, f))
         }
         None => None,
@@ -209,7 +212,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
                 max_speed = max_speed.max((ends[i] - p[i]).length() / dt);
             }
         }
-        if let Some((_, w)) = &mut csv {
+        if let Some((pending, w)) = &mut csv {
             for &i in &track {
                 let r = tree.segments.end(i);
                 let e = ends[i];
@@ -223,7 +226,8 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
                     e.x - r.x,
                     e.y - r.y,
                     e.z - r.z
-                )?;
+                )
+                .with_context(|| format!("writing {}", pending.path().display()))?;
             }
         }
         prev = Some(ends);
@@ -232,8 +236,8 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some((pending, w)) = csv {
-        w.into_inner().map_err(|e| e.into_error())?;
         let path = pending.path().to_path_buf();
+        w.into_inner().map_err(|e| e.into_error()).with_context(|| format!("writing {}", path.display()))?;
         pending.commit().with_context(|| format!("writing {}", path.display()))?;
         println!("wrote {} ({} tracked segments × {frames} frames)", path.display(), track.len());
     }

@@ -1,7 +1,7 @@
 //! `sylva view`: the interactive viewer (`sylva-viewer`), behind the cargo feature `viewer`:
 //! the arguments, the script file and the display check.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use std::path::PathBuf;
 
 /// Arguments of `sylva view`.
@@ -33,7 +33,7 @@ pub struct ViewArgs {
 pub fn run(args: &ViewArgs) -> Result<()> {
     let script = match &args.script {
         Some(p) => {
-            let text = std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            let text = sylva_core::io::read_text(p).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
             parse(&text, &p.display().to_string())?
         }
         None => Vec::new(),

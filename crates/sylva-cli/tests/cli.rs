@@ -152,43 +152,157 @@ fn render_rejects_bad_scenes_naming_the_problem() {
     assert!(!dir.path().join("out").exists());
 }
 
+/// Signal numbers and the exit status a command stopped by each gives (`128 + n`).
+#[cfg(unix)]
+const SIGNALS: [(&str, i32); 3] = [("INT", 130), ("TERM", 143), ("HUP", 129)];
+
+/// Every entry under `dir`, recursively (names relative to it).
+fn entries(dir: &std::path::Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten() {
+            let p = e.unwrap().path();
+            out.push(p.strip_prefix(dir).unwrap().to_string_lossy().into_owned());
+            if p.is_dir() {
+                stack.push(p);
+            }
+        }
+    }
+    out
+}
+
+/// Sends `signal` to the child once `ready` holds, and returns its exit code and stderr.
+#[cfg(unix)]
+fn interrupt(mut child: std::process::Child, signal: &str, ready: impl Fn() -> bool) -> (Option<i32>, String) {
+    let start = std::time::Instant::now();
+    while !ready() {
+        assert!(start.elapsed().as_secs() < 300, "SIG{signal}: not ready after 300 s");
+        assert!(child.try_wait().unwrap().is_none(), "SIG{signal}: the command ended before it was interrupted");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert!(child.try_wait().unwrap().is_none(), "SIG{signal}: the command ended before it was interrupted");
+    let killed = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+fn spawn(dir: &std::path::Path, args: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .current_dir(dir)
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 /// An interrupted render (Ctrl-C, and SIGTERM or SIGHUP from a session manager) stops
-/// cleanly: no GIF, no temporary files; the frames written so far are complete PNGs.
+/// between frames: no GIF, no frames, no temporary files, exit status 128 + signal.
 #[cfg(unix)]
 #[test]
 fn interrupted_render_leaves_no_partial_output_on_int_term_and_hup() {
-    for signal in ["INT", "TERM", "HUP"] {
+    for (signal, code) in SIGNALS {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("tiny.toml"), TINY_SCENE).unwrap();
-        let mut child = Command::new(env!("CARGO_BIN_EXE_sylva"))
-            .current_dir(dir.path())
-            .args(["render", "tiny.toml"])
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
-        let third = dir.path().join("out/frames/tiny_0002.png");
-        let start = std::time::Instant::now();
-        while !third.exists() {
-            assert!(start.elapsed().as_secs() < 300, "no frames after 300 s");
-            assert!(child.try_wait().unwrap().is_none(), "render ended before it was interrupted");
-            std::thread::sleep(std::time::Duration::from_millis(20));
+        let out = dir.path().join("out");
+        let child = spawn(dir.path(), &["render", "tiny.toml"]);
+        // Three frames are written (to the temporary frames directory) before the signal.
+        let third = || entries(&out).iter().any(|e| e.contains(".frames.tmp-") && e.ends_with("tiny_0002.png"));
+        let (status, err) = interrupt(child, signal, third);
+        assert_eq!(status, Some(code), "SIG{signal}: {err}");
+        assert!(err.contains(&format!("SIG{signal}")) && err.contains("stopped"), "SIG{signal}: {err}");
+        let left = entries(&out);
+        assert!(left.is_empty(), "SIG{signal}: an interrupted render left {left:?}");
+    }
+}
+
+/// `simulate --csv`, `export` and `bench` stop on each signal with 128 + signal, leaving
+/// neither a temporary file nor an output under its final name.
+#[cfg(unix)]
+#[test]
+fn signals_stop_simulate_export_and_bench_with_no_file_left() {
+    let long: [(&str, &[&str]); 3] = [
+        (
+            "simulate",
+            &["simulate", "--species", "palm", "--method", "akagi", "--seconds", "100000", "--csv", "out/t.csv"],
+        ),
+        (
+            "export",
+            &["export", "--species", "black_tupelo", "--method", "hsm", "--seconds", "20", "--out", "out/t.glb"],
+        ),
+        ("bench", &["bench", "song-t3", "--backend", "cpu", "--out-dir", "out"]),
+    ];
+    for (name, args) in long {
+        for (signal, code) in SIGNALS {
+            let dir = tempfile::tempdir().unwrap();
+            let out = dir.path().join("out");
+            std::fs::create_dir(&out).unwrap();
+            let child = spawn(dir.path(), args);
+            let start = std::time::Instant::now();
+            // simulate's CSV is open as a temporary file from its first frame; the others
+            // are interrupted while they work.
+            let ready = || match name {
+                "simulate" => entries(&out).iter().any(|e| e.contains(".tmp-")),
+                _ => start.elapsed().as_millis() > 1500,
+            };
+            let (status, err) = interrupt(child, signal, ready);
+            assert_eq!(status, Some(code), "{name}, SIG{signal}: {err}");
+            assert!(err.contains("stopped"), "{name}, SIG{signal}: {err}");
+            let left = entries(&out);
+            assert!(left.is_empty(), "{name}, SIG{signal}: left {left:?}");
         }
-        let killed = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
-        assert!(killed.success());
-        let out = child.wait_with_output().unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "SIG{signal}: an interrupted render must fail");
-        assert!(err.contains("interrupted"), "SIG{signal}: {err}");
-        assert!(!dir.path().join("out/tiny.gif").exists(), "SIG{signal}: a partial GIF was left");
-        for e in std::fs::read_dir(dir.path().join("out"))
-            .unwrap()
-            .chain(std::fs::read_dir(dir.path().join("out/frames")).unwrap())
-        {
-            let name = e.unwrap().file_name().to_string_lossy().into_owned();
-            assert!(!name.contains(".tmp"), "SIG{signal}: temporary file {name} left");
+    }
+}
+
+/// Runs `sylva` in a private mount namespace (`unshare -rm`) with a tmpfs mounted at `out`
+/// with `options`; returns whether it succeeded, its stderr, and the files left on the
+/// tmpfs (listed inside the namespace, where the tmpfs lives). `None` where user namespaces
+/// are not available (allowed outside CI only, and said so).
+#[cfg(target_os = "linux")]
+fn on_tmpfs(dir: &std::path::Path, options: &str, args: &[&str]) -> Option<(bool, String, Vec<String>)> {
+    let probe = Command::new("unshare").args(["-rm", "true"]).output();
+    if !probe.is_ok_and(|o| o.status.success()) {
+        assert!(std::env::var("CI").is_err(), "CI: `unshare -rm` (user namespaces) is needed for the tmpfs tests");
+        eprintln!("SKIPPED: no user namespaces (`unshare -rm`) for the tmpfs tests");
+        return None;
+    }
+    std::fs::create_dir_all(dir.join("out")).unwrap();
+    let script = r#"opts=$1; shift; mount -t tmpfs -o "$opts" tmpfs out || exit 99; "$@" >/dev/null; rc=$?; find out -type f; exit $rc"#;
+    let out = Command::new("unshare")
+        .current_dir(dir)
+        .args(["-rm", "sh", "-c", script, "sh", options, env!("CARGO_BIN_EXE_sylva")])
+        .args(args)
+        .output()
+        .unwrap();
+    assert_ne!(out.status.code(), Some(99), "mounting the tmpfs failed");
+    let files = String::from_utf8_lossy(&out.stdout).lines().map(str::to_string).collect();
+    Some((out.status.success(), String::from_utf8_lossy(&out.stderr).into_owned(), files))
+}
+
+/// A full disk and a read-only directory: a clear error naming the path, a non-zero exit,
+/// and no file left, neither a temporary one nor an incomplete one under its final name.
+#[cfg(target_os = "linux")]
+#[test]
+fn full_disk_and_read_only_directory_fail_clearly_and_leave_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), TINY_SCENE.replace("seconds = 20", "seconds = 1")).unwrap();
+    let commands: [(&str, &[&str]); 4] = [
+        ("render, GIF and PNG frames", &["render", "tiny.toml", "--out-dir", "out/r"]),
+        ("render, GIF only", &["render", "tiny.toml", "--out-dir", "out/r", "--no-png"]),
+        ("simulate --csv", &["simulate", "--species", "palm", "--seconds", "30", "--csv", "out/t.csv"]),
+        ("export", &["export", "--species", "palm", "--method", "zioma", "--out", "out/t.glb"]),
+    ];
+    // 24 KiB holds the directories and a few frames, not the rest.
+    for (options, expect) in [("size=24k", "No space left"), ("ro", "Read-only")] {
+        for (name, args) in commands {
+            let Some((ok, err, files)) = on_tmpfs(dir.path(), options, args) else { return };
+            assert!(!ok, "{name} on a {options} tmpfs must fail");
+            assert!(err.contains(expect) && err.contains("out/"), "{name}, {options}: the error names the path: {err}");
+            assert!(!err.contains("panicked"), "{name}, {options}: {err}");
+            assert!(files.is_empty(), "{name}, {options}: left {files:?}");
         }
-        image::open(&third).expect("frames written before the interrupt are complete");
     }
 }
 
@@ -242,6 +356,71 @@ fn bad_input_gives_a_located_error_and_no_file() {
     let (ok, _, err) = sylva(dir.path(), &["generate", "-s", "nope"]);
     assert!(!ok);
     assert!(err.contains("nope") && err.contains("weeping_willow"), "{err}");
+}
+
+/// The CLI-level cases of the hardening report, each named after what broke: a panic (exit
+/// 101), a limit that did not hold, or a message that misled.
+#[test]
+fn regressions_panics_limits_and_messages() {
+    let dir = tempfile::tempdir().unwrap();
+    let regressions = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../sylva-core/tests/regressions");
+    let input = |name: &str| regressions.join(name).to_string_lossy().into_owned();
+    let status = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_sylva")).current_dir(dir.path()).args(args).output().unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    // A tree with no segments panicked in `simulate` for every method; `render` and `export`
+    // accepted it.
+    let empty = input("tree_with_no_segments.lsys");
+    for method in ["zioma", "akagi", "skjermo", "hsm"] {
+        let (code, err) = status(&["simulate", "--species", &empty, "--method", method, "--seconds", "0.1"]);
+        assert_eq!(code, Some(1), "{method}: {err}");
+        assert!(err.contains("no segment"), "{method}: {err}");
+    }
+    let (code, err) = status(&["export", "--species", &empty, "--out", "e.glb"]);
+    assert!(code == Some(1) && err.contains("no segment"), "{err}");
+    // Bracket nesting of 255 panicked in `simulate`; NaN clamp bounds in `generate`.
+    for (name, cmd) in [("bracket_nesting_255.lsys", "simulate"), ("clamp_with_nan_bounds.lsys", "generate")] {
+        let (code, err) = status(&[cmd, "--species", &input(name)]);
+        assert_eq!(code, Some(1), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{name}: {err}");
+    }
+    // Sides outside 3–64 and runaway thread counts were accepted.
+    for args in [["--sides", "0"], ["--sides", "4294967295"], ["--sides", "65"], ["--threads", "100000"]] {
+        let (code, err) = status(&["generate", "-o", "-", args[0], args[1]]);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(err.contains(args[0]) && err.contains("expected") || err.contains("3..=64"), "{args:?}: {err}");
+    }
+    // /dev/zero slipped past the 1 MiB input limit and read until allocation failed.
+    #[cfg(unix)]
+    {
+        let (code, err) = status(&["generate", "--species", "/dev/zero"]);
+        assert!(code == Some(1) && err.contains("/dev/zero") && err.contains("limit"), "{err}");
+    }
+    // Limit messages were printed twice and named flags that did not exist.
+    let (code, err) = status(&["simulate", "--species", "quaking_aspen", "--max-segments", "10"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert_eq!(err.matches("max_segments").count(), 1, "said once: {err}");
+    assert!(err.contains("--max-segments"), "{err}");
+    let (code, err) = status(&["generate", "--species", "big.lsys", "--max-modules", "1000"]);
+    assert_eq!(code, Some(1), "a missing file: {err}");
+    std::fs::write(dir.path().join("big.lsys"), "iterations: 30\naxiom: A\nA -> AA\n").unwrap();
+    let (code, err) = status(&["generate", "--species", "big.lsys", "--max-modules", "1000"]);
+    assert!(code == Some(1) && err.contains("--max-modules") && err.matches("max_modules").count() == 1, "{err}");
+    // A flag's bad value was blamed on the scene file.
+    let (code, err) = status(&["render", "--seconds", "1e9"]);
+    assert!(code == Some(1) && err.starts_with("Error: --seconds"), "{err}");
+    // Scene memory had no bound: 64 weeping willows peaked at 12 GB. The same scene of
+    // palms (8,456 segments and leaves each) against a limit of 20,000 stops at the third,
+    // before any tree is set up.
+    let palms: String = (0..64)
+        .map(|k| format!("[[tree]]\nspecies = \"palm\"\nmethod = \"zioma\"\nposition = [{k}.0, 0.0, 0.0]\n"))
+        .collect();
+    std::fs::write(dir.path().join("palms.toml"), palms).unwrap();
+    let (code, err) = status(&["render", "palms.toml", "--seconds", "0.1", "--max-scene-elements", "20000"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("tree[2]") && err.contains("`max_scene_elements` = 20000"), "{err}");
+    assert!(err.contains("--max-scene-elements"), "{err}");
 }
 
 fn png_size(path: &std::path::Path) -> (u32, u32) {

@@ -4,11 +4,47 @@
 use std::fs;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Temporary paths of every [`PendingFile`] alive in the process, so that a signal handler
+/// can remove them before the process exits ([`abandon_pending`]).
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// Set by [`abandon_pending`]: no temporary file may be created from then on.
+static ABANDONED: AtomicBool = AtomicBool::new(false);
+
+fn pending() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    PENDING.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes every pending temporary file (and directory) of the process and refuses new ones:
+/// what a signal handler calls just before the process exits, so that an interrupt leaves
+/// neither a temporary file nor a partial output under a final name. Returns how many paths
+/// were removed.
+pub fn abandon_pending() -> usize {
+    ABANDONED.store(true, Ordering::SeqCst);
+    let list = pending();
+    let mut removed = 0;
+    for p in list.iter() {
+        let gone = if p.is_dir() { fs::remove_dir_all(p) } else { fs::remove_file(p) };
+        removed += usize::from(gone.is_ok());
+    }
+    removed
+}
+
+fn refuse_if_abandoned(tmp: &Path) -> io::Result<()> {
+    if ABANDONED.load(Ordering::SeqCst) {
+        let _ = if tmp.is_dir() { fs::remove_dir_all(tmp) } else { fs::remove_file(tmp) };
+        return Err(io::Error::new(io::ErrorKind::Interrupted, "interrupted: no output is written"));
+    }
+    Ok(())
+}
 
 /// An output file written completely or not at all: the content goes to a temporary file
 /// beside `path` (`.NAME.tmp-PID.EXT`, the extension kept last for encoders that choose the
 /// format by it), renamed over `path` by [`PendingFile::commit`]. Dropped uncommitted (an
-/// error, an interrupt), the temporary file is removed and `path` is left as it was.
+/// error, an interrupt), the temporary file is removed and `path` is left as it was. While
+/// it lives, its temporary path is registered for [`abandon_pending`].
 #[derive(Debug)]
 pub struct PendingFile {
     tmp: PathBuf,
@@ -31,6 +67,8 @@ impl PendingFile {
             Some(ext) => dir.join(format!(".{name}.tmp-{}.{}", std::process::id(), ext.to_string_lossy())),
             None => dir.join(format!(".{name}.tmp-{}", std::process::id())),
         };
+        refuse_if_abandoned(&tmp)?;
+        pending().push(tmp.clone());
         Ok(Self { tmp, path: path.to_path_buf(), done: false })
     }
 
@@ -46,12 +84,21 @@ impl PendingFile {
 
     /// Creates the temporary file for writing.
     pub fn create(&self) -> io::Result<fs::File> {
-        fs::File::create(&self.tmp)
+        let f = fs::File::create(&self.tmp)?;
+        refuse_if_abandoned(&self.tmp)?;
+        Ok(f)
     }
 
-    /// Flushes the temporary file to disk and renames it over the final path.
+    /// Flushes the temporary file to disk and renames it over the final path. An empty
+    /// temporary file is refused: every format Sylva writes has content, and a write that
+    /// failed silently (a full disk under an encoder that drops its errors) leaves one.
     pub fn commit(mut self) -> io::Result<()> {
-        fs::File::open(&self.tmp)?.sync_all()?;
+        let f = fs::File::open(&self.tmp)?;
+        if f.metadata()?.len() == 0 {
+            return Err(io::Error::other(format!("{} came out empty; nothing was written", self.tmp.display())));
+        }
+        f.sync_all()?;
+        refuse_if_abandoned(&self.tmp)?;
         fs::rename(&self.tmp, &self.path)?;
         self.done = true;
         Ok(())
@@ -62,6 +109,73 @@ impl Drop for PendingFile {
     fn drop(&mut self) {
         if !self.done {
             let _ = fs::remove_file(&self.tmp);
+        }
+        let mut list = pending();
+        if let Some(i) = list.iter().rposition(|p| *p == self.tmp) {
+            list.swap_remove(i);
+        }
+    }
+}
+
+/// A set of output files (a render's frames) written together or not at all: they go to a
+/// temporary directory (`PARENT/.NAME.tmp-PID`), moved into the final directory by
+/// [`PendingDir::commit`]. Dropped uncommitted, the temporary directory is removed. While it
+/// lives, it is registered for [`abandon_pending`].
+#[derive(Debug)]
+pub struct PendingDir {
+    tmp: PathBuf,
+    done: bool,
+}
+
+impl PendingDir {
+    /// Creates the temporary directory `.NAME.tmp-PID` in `parent`.
+    pub fn new(parent: &Path, name: &str) -> io::Result<Self> {
+        let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
+        refuse_if_abandoned(&tmp)?;
+        pending().push(tmp.clone());
+        let dir = Self { tmp, done: false };
+        fs::create_dir_all(&dir.tmp)?;
+        refuse_if_abandoned(&dir.tmp)?;
+        Ok(dir)
+    }
+
+    /// Where the files go until they are committed.
+    pub fn tmp(&self) -> &Path {
+        &self.tmp
+    }
+
+    /// Moves every file into `dir` (created when missing), after removing the files of `dir`
+    /// that `stale` names (an earlier run's), then removes the temporary directory. Returns
+    /// the number of files moved.
+    pub fn commit(mut self, dir: &Path, stale: impl Fn(&str) -> bool) -> io::Result<usize> {
+        fs::create_dir_all(dir)?;
+        for e in fs::read_dir(dir)? {
+            let e = e?;
+            if e.file_type()?.is_file() && stale(&e.file_name().to_string_lossy()) {
+                fs::remove_file(e.path())?;
+            }
+        }
+        let mut moved = 0;
+        for e in fs::read_dir(&self.tmp)? {
+            let e = e?;
+            refuse_if_abandoned(&self.tmp)?;
+            fs::rename(e.path(), dir.join(e.file_name()))?;
+            moved += 1;
+        }
+        fs::remove_dir(&self.tmp)?;
+        self.done = true;
+        Ok(moved)
+    }
+}
+
+impl Drop for PendingDir {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = fs::remove_dir_all(&self.tmp);
+        }
+        let mut list = pending();
+        if let Some(i) = list.iter().rposition(|p| *p == self.tmp) {
+            list.swap_remove(i);
         }
     }
 }
@@ -79,17 +193,141 @@ pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> io::Result
 /// Largest preset or grammar file read, bytes.
 pub const MAX_FILE_BYTES: u64 = 1 << 20;
 
-/// Reads a text file of at most [`MAX_FILE_BYTES`].
+/// Reads a text file of at most [`MAX_FILE_BYTES`]. The limit holds for what is read, not
+/// what the file system reports, so devices and pipes (`/dev/zero`, `/dev/stdin`) stop at it
+/// too. Bad UTF-8 is reported with its line and column.
 pub fn read_text(path: &Path) -> Result<String, String> {
+    let too_large = |what: String| {
+        format!("file is {what}, larger than the {MAX_FILE_BYTES} byte limit for presets, grammars, scenes and winds")
+    };
     let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(format!(
-            "file is {} bytes, larger than the {} byte limit for presets and grammars",
-            meta.len(),
-            MAX_FILE_BYTES
-        ));
+    if meta.is_dir() {
+        return Err("is a directory, expected a text file".into());
     }
-    std::fs::read_to_string(path).map_err(|e| e.to_string())
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(too_large(format!("{} bytes", meta.len())));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| io::Read::read_to_end(&mut io::Read::take(f, MAX_FILE_BYTES + 1), &mut bytes))
+        .map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(too_large(format!("more than {MAX_FILE_BYTES} bytes")));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let good = e.utf8_error().valid_up_to();
+        let text = std::str::from_utf8(&e.as_bytes()[..good]).unwrap_or_default();
+        let (line, col) = line_col(text, good);
+        format!("line {line}, column {col}: invalid UTF-8 (byte {good}); expected UTF-8 text")
+    })
+}
+
+/// Longest run of the input quoted back in an error message, characters.
+pub const MAX_QUOTE: usize = 60;
+
+/// A TOML parse error as Sylva reports it: 1-based line and column, and the message with
+/// every quoted token cut to [`MAX_QUOTE`] characters, long digit runs (a float written out
+/// in full) shortened to scientific notation, and the key named where the parser's message
+/// names none (`duplicate key`, `invalid type`).
+pub fn toml_error(text: &str, e: &toml::de::Error) -> (usize, usize, String) {
+    let mut start = e.span().map_or(0, |s| s.start.min(text.len()));
+    let mut message = shorten(e.message().trim());
+    // A tagged table (`[[field]]` with `kind = …`) is read whole before its fields, so a
+    // wrong type is reported at the table: find the first line in it holding a value of
+    // the type found.
+    if text[start..].starts_with('[')
+        && let Some(found) = message.strip_prefix("invalid type: ").and_then(|m| m.split(',').next())
+    {
+        let looks = |v: &str| match found.split_whitespace().next().unwrap_or("") {
+            "map" => v.starts_with('{'),
+            "sequence" => v.starts_with('['),
+            "string" => v.starts_with('"') || v.starts_with('\''),
+            "boolean" => v == "true" || v == "false",
+            "integer" | "floating" => v.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+'),
+            _ => false,
+        };
+        // The span is the table's header: search the table, up to the next header.
+        let body = text[start..].find('\n').map_or(text.len(), |i| start + i + 1);
+        let end = text[body..].find("\n[").map_or(text.len(), |i| body + i + 1);
+        let mut offset = start;
+        for l in text[start..end].split_inclusive('\n') {
+            if let Some((_, v)) = l.split_once('=')
+                && looks(v.trim())
+            {
+                start = offset;
+                break;
+            }
+            offset += l.len();
+        }
+    }
+    let (line, column) = line_col(text, start);
+    let quotes_a_key = message.contains("field `") || message.contains("key `");
+    if !quotes_a_key && (message.starts_with("duplicate key") || message.starts_with("invalid type")) {
+        // The key is what precedes `=` on the error's line (the span is the key or its value).
+        let line_text = text[..start].rsplit('\n').next().unwrap_or("");
+        let rest = text[start..].split('\n').next().unwrap_or("");
+        let whole = format!("{line_text}{rest}");
+        if let Some((key, _)) = whole.split_once('=') {
+            let key = key.trim().trim_start_matches('{').trim();
+            if !key.is_empty() && !key.starts_with('[') {
+                message = format!("{message} (key `{}`)", cut(key));
+            }
+        }
+    }
+    (line, column, message)
+}
+
+/// `s` cut to [`MAX_QUOTE`] characters, saying how long it was.
+pub fn cut(s: &str) -> String {
+    let n = s.chars().count();
+    if n <= MAX_QUOTE {
+        return s.to_string();
+    }
+    format!("{}… ({n} characters)", s.chars().take(MAX_QUOTE).collect::<String>())
+}
+
+/// Cuts each backquoted token of a message and shortens digit runs longer than 17.
+fn shorten(message: &str) -> String {
+    let mut out = String::new();
+    let mut parts = message.split('`');
+    if let Some(first) = parts.next() {
+        out.push_str(&digits(first));
+    }
+    for (k, part) in parts.enumerate() {
+        out.push('`');
+        out.push_str(&if k % 2 == 0 { cut(&digits(part)) } else { digits(part) });
+    }
+    out
+}
+
+/// Digit runs longer than 17 (an f64 written out in full) as `d.ddde±N`.
+fn digits(s: &str) -> String {
+    let mut out = String::new();
+    let chars: Vec<char> = s.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        if chars[i].is_ascii_digit() {
+            let j = chars[i..].iter().position(|c| !c.is_ascii_digit()).map_or(chars.len(), |k| i + k);
+            let run: String = chars[i..j].iter().collect();
+            if run.len() > 17 {
+                // A fraction `.000…` after a long integer part carries nothing.
+                let mut end = j;
+                if chars.get(j) == Some(&'.') {
+                    end = chars[j + 1..].iter().position(|c| !c.is_ascii_digit()).map_or(chars.len(), |k| j + 1 + k);
+                }
+                let v: f64 = chars[i..end].iter().collect::<String>().parse().unwrap_or(f64::INFINITY);
+                out.push_str(&format!("{v:.3e}"));
+                i = end;
+                continue;
+            }
+            out.push_str(&run);
+            i = j;
+            continue;
+        }
+        out.push(chars[i]);
+        i += 1;
+    }
+    out
 }
 
 /// [`field_line`] for a path into a table value (`tree[0].params.frequency` set in an

@@ -25,6 +25,10 @@ pub struct Limits {
     pub max_branch_depth: usize,
     /// Deepest expression nesting the grammar parser accepts. Default 64.
     pub max_expression_depth: usize,
+    /// Largest scene: segments and leaves summed over every tree and each of its instances
+    /// (what the per-frame poses, meshes and simulation state grow with, about 1 KiB each).
+    /// Default 3 million: about 3 GiB; 64 weeping willows (12 million) peak at 12 GB.
+    pub max_scene_elements: usize,
 }
 
 impl Default for Limits {
@@ -37,6 +41,7 @@ impl Default for Limits {
             max_iterations: 1_000,
             max_branch_depth: 100_000,
             max_expression_depth: 64,
+            max_scene_elements: 3_000_000,
         }
     }
 }

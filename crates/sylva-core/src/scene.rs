@@ -25,7 +25,7 @@
 //! Unknown keys, wrong types and out-of-range values are errors naming the file, line and
 //! field.
 
-use crate::io::{field_line, line_col};
+use crate::io::field_line;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -318,6 +318,10 @@ pub struct Scene {
     /// The text it was read from (for messages).
     #[serde(skip)]
     pub source: SourceText,
+    /// Limits on each tree's growth and on the scene's size (set by the application; the
+    /// CLI's `--max-…` flags).
+    #[serde(skip)]
+    pub limits: crate::Limits,
 }
 
 fn default_wind() -> String {
@@ -373,8 +377,8 @@ impl Scene {
     /// Parses scene text; `file` names it in errors, `base_dir` anchors relative paths.
     pub fn from_toml(text: &str, file: &str, base_dir: &Path) -> Result<Self, SceneError> {
         let mut scene: Scene = toml::from_str(text).map_err(|e| {
-            let (line, column) = e.span().map_or((1, 1), |s| line_col(text, s.start));
-            SceneError::Toml { file: file.to_string(), line, column, message: e.message().trim().to_string() }
+            let (line, column, message) = crate::io::toml_error(text, &e);
+            SceneError::Toml { file: file.to_string(), line, column, message }
         })?;
         scene.base_dir = base_dir.to_path_buf();
         scene.file = file.to_string();

@@ -5,7 +5,7 @@
 
 use crate::generate::lsystem::{Grammar, GrammarError, LSystemError, LSystemOptions};
 use crate::generate::weber_penn::{WeberPennError, WeberPennParams};
-use crate::io::{field_line, line_col, read_text};
+use crate::io::{field_line, read_text};
 use crate::limits::Limits;
 use crate::model::Tree;
 use std::path::Path;
@@ -111,8 +111,8 @@ impl SpeciesSource {
     /// Parses Weber–Penn TOML text; `file` names it in errors.
     pub fn parse_species(text: &str, file: &str) -> Result<WeberPennParams, SpeciesError> {
         let params: WeberPennParams = toml::from_str(text).map_err(|e| {
-            let (line, column) = e.span().map_or((1, 1), |s| line_col(text, s.start));
-            SpeciesError::Toml { file: file.to_string(), line, column, message: e.message().trim().to_string() }
+            let (line, column, message) = crate::io::toml_error(text, &e);
+            SpeciesError::Toml { file: file.to_string(), line, column, message }
         })?;
         params.check().map_err(|e| SpeciesError::Field {
             file: file.to_string(),
@@ -125,12 +125,21 @@ impl SpeciesSource {
 
     /// Resolves a preset name or a file path.
     pub fn resolve(arg: &str) -> Result<Self, SpeciesError> {
+        Self::resolve_with(arg, &Limits::default())
+    }
+
+    /// Resolves a preset name or a file path, parsing a grammar within `limits` (its
+    /// `iterations` and expression depth).
+    pub fn resolve_with(arg: &str, limits: &Limits) -> Result<Self, SpeciesError> {
         if let Some(p) = PRESETS.iter().find(|p| p.name == arg) {
             return Self::from_preset(p);
         }
         let path = Path::new(arg);
         if path.exists() {
             let text = read_text(path).map_err(|message| SpeciesError::Io { file: arg.to_string(), message })?;
+            if !arg.ends_with(".toml") {
+                return Ok(Self::LSystem(Box::new(Grammar::parse_with_limits(&text, arg, limits)?)));
+            }
             return Self::from_text(&text, arg);
         }
         Err(SpeciesError::NotFound {

@@ -41,6 +41,64 @@ fn forward_kinematics_matches_a_hand_computed_chain() {
     close(pose.end(&t, 2), Vec3::new(-1.0, -2.0, 0.0));
 }
 
+/// Random unit rotations of up to about 0.3 rad, one per segment and instance.
+fn random_rotations(n: usize, seed: u64) -> Vec<[f32; 4]> {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| {
+            let axis = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            Quat::from_axis_angle(axis.try_normalize().unwrap_or(Vec3::Y), rng.random_range(-0.3..0.3)).to_array()
+        })
+        .collect()
+}
+
+#[test]
+fn one_pass_forward_kinematics_matches_the_gpu_kernels_twins() {
+    use sylva_core::pose::fk::{
+        depth_buckets, pose_accumulate, pose_forward, pose_level, pose_positions, positions_forward,
+    };
+    let deep = Grammar::parse("iterations: 900\naxiom: A\nA -> F/(37)&(1)A\n", "stem.lsys")
+        .unwrap()
+        .generate(&LSystemOptions::default())
+        .unwrap();
+    for (name, t, instances) in [("aspen", tree("quaking_aspen"), 3), ("900-segment stem", deep, 1)] {
+        let n = t.segments.len();
+        let parent = &t.segments.parent;
+        let rest: Vec<[f32; 4]> = t.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
+        let delta = random_rotations(n * instances, 7);
+        let (mut acc, mut joints) = (vec![[0.0f32; 4]; n * instances], vec![[0.0f32; 4]; n * instances]);
+        pose_forward(parent, &rest, &delta, &mut acc, &mut joints);
+        // Level by level (pose_level.wgsl's twin) does the same arithmetic: bit for bit.
+        for k in 0..instances {
+            let r = k * n..(k + 1) * n;
+            let (mut la, mut ld, mut lj) = (vec![[0.0f32; 4]; n], vec![[0.0f32; 4]; n], vec![[0.0f32; 4]; n]);
+            for b in depth_buckets(parent) {
+                pose_level(&b, parent, &rest, &delta[r.clone()], &mut la, &mut ld, &mut lj);
+            }
+            assert_eq!(la, acc[r.clone()], "{name}: rotations, instance {k}");
+            assert_eq!(lj, joints[r.clone()], "{name}: joints, instance {k}");
+        }
+        // The ancestor walks multiply in another order: equal to rounding. Tolerance: 1e-5 of
+        // the tree's height per joint and 1e-5 per quaternion component, over a chain of up
+        // to 900 rotations.
+        let (mut wa, mut wj) = (vec![[0.0f32; 4]; n * instances], vec![[0.0f32; 4]; n * instances]);
+        pose_accumulate(parent, &delta, &mut wa);
+        pose_positions(parent, &rest, &wa, &mut wj);
+        let height = t.stats().height.max(1.0);
+        for i in 0..n * instances {
+            let dq = (Quat::from_array(acc[i]).dot(Quat::from_array(wa[i])).abs() - 1.0).abs();
+            assert!(dq < 1e-5, "{name}: segment {i}: rotations differ by {dq}");
+            let dj = (Vec3::from_slice(&joints[i][..3]) - Vec3::from_slice(&wj[i][..3])).length();
+            assert!(dj < 1e-5 * height * (1.0 + n as f32 / 100.0), "{name}: segment {i}: joints differ by {dj} m");
+        }
+        // Positions from given rotations (HSM's path) match the full pass.
+        let mut pj = vec![[0.0f32; 4]; n * instances];
+        positions_forward(parent, &rest, &acc, &mut pj);
+        assert_eq!(pj, joints, "{name}: positions_forward");
+    }
+}
+
 #[test]
 fn zioma_in_still_air_is_exactly_at_rest() {
     for p in PRESETS {

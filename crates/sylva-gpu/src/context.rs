@@ -21,6 +21,9 @@ pub enum GpuError {
     /// Mapping a buffer for readback failed.
     #[error("reading back a GPU buffer failed: {0}")]
     Map(String),
+    /// The shared context could not be set up (the first attempt's error, kept).
+    #[error("{0}")]
+    Unavailable(String),
     /// An input is larger than the device allows.
     #[error("{what}: {bytes} bytes exceeds the device's limit of {limit} bytes")]
     TooLarge { what: &'static str, bytes: u64, limit: u64 },
@@ -151,7 +154,7 @@ impl GpuContext {
         static SHARED: OnceLock<Result<Arc<GpuContext>, String>> = OnceLock::new();
         match SHARED.get_or_init(|| GpuContext::new(&GpuOptions::default()).map(Arc::new).map_err(|e| e.to_string())) {
             Ok(c) => Ok(c),
-            Err(e) => Err(GpuError::NoAdapter(e.clone())),
+            Err(e) => Err(GpuError::Unavailable(e.clone())),
         }
     }
 

@@ -12,12 +12,12 @@ use crate::registry::MethodRegistry;
 use crate::wind::{ClockWind, WorldWind};
 use glam::{Mat4, Quat, Vec3};
 use std::sync::Arc;
+use sylva_core::Tree;
 use sylva_core::mesh::{DeformLayout, DeformerParams, MeshLayout, MeshParams, RawVertex, SkinLayout};
 use sylva_core::methods::{Animator, MethodOptions};
 use sylva_core::pose::{Placement, Pose, SeamPose};
 use sylva_core::scene::{BackendChoice, Scene, SceneTree};
 use sylva_core::species::SpeciesSource;
-use sylva_core::{Limits, Tree};
 use sylva_gpu::mesh::GpuMesh;
 use sylva_gpu::mesh::deform::GpuDeform;
 use sylva_gpu::mesh::skin::GpuSkin;
@@ -238,10 +238,42 @@ fn instance(position: [f32; 3], yaw_deg: f32, scale: f32, tint: Vec3) -> Instanc
 }
 
 impl WorldTree {
+    /// Grows tree `i` of `scene` and checks it, with `others` segments and leaves of the
+    /// scene's other trees and instances, against the scene's `max_scene_elements`: before
+    /// any simulation or mesh of the scene is set up.
+    pub(crate) fn grow(scene: &Scene, i: usize, st: &SceneTree, others: usize) -> Result<Arc<Tree>, RuntimeError> {
+        let species = scene.resolve_path(&st.species);
+        let species_error =
+            |source| RuntimeError::Species { file: scene.file.clone(), index: i, source: Box::new(source) };
+        let source = SpeciesSource::resolve_with(&species, &scene.limits).map_err(species_error)?;
+        let tree = Arc::new(source.generate(st.seed, &scene.limits, None).map_err(species_error)?);
+        let total = others.saturating_add(Self::elements(&tree, 1 + st.copies.len()));
+        if total > scene.limits.max_scene_elements {
+            return Err(RuntimeError::Limit(format!(
+                "{}: tree[{i}]: the scene would hold {total} segments and leaves over all its trees and their instances, \
+                 more than the limit `max_scene_elements` = {} (raise it with --max-scene-elements)",
+                scene.file, scene.limits.max_scene_elements
+            )));
+        }
+        Ok(tree)
+    }
+
+    fn elements(tree: &Tree, instances: usize) -> usize {
+        (tree.segments.len() + tree.leaves.len()).saturating_mul(instances.max(1))
+    }
+
+    /// Segments and leaves over all its instances: what it counts against the scene's
+    /// `max_scene_elements`.
+    pub fn scene_elements(&self) -> usize {
+        Self::elements(&self.tree, self.instances)
+    }
+
     /// Grows, lays out and sets up tree `i` of `scene` (`st`, which may differ from
     /// `scene.trees[i]` when an editor changes it): its method on the CPU or the GPU (`auto`:
     /// GPU unless the adapter is a software rasteriser), its meshes, and the phase groups of
-    /// its copies (`dt` converts their offsets to steps).
+    /// its copies (`dt` converts their offsets to steps). The tree is `grown` ([`Self::grow`])
+    /// or grown here, checked with `others` against the scene's `max_scene_elements`.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn build(
         ctx: &GpuContext,
         registry: &MethodRegistry,
@@ -250,6 +282,8 @@ impl WorldTree {
         st: &SceneTree,
         wind: &mut WorldWind,
         dt: f32,
+        grown: Option<Arc<Tree>>,
+        others: usize,
     ) -> Result<Self, RuntimeError> {
         let method_error = |source: sylva_core::methods::MethodError| {
             let field = match &source {
@@ -266,11 +300,10 @@ impl WorldTree {
             }
         };
         let entry = *registry.entry(st.method.as_str()).map_err(method_error)?;
-        let species = scene.resolve_path(&st.species);
-        let species_error =
-            |source| RuntimeError::Species { file: scene.file.clone(), index: i, source: Box::new(source) };
-        let source = SpeciesSource::resolve(&species).map_err(species_error)?;
-        let tree = Arc::new(source.generate(st.seed, &Limits::default(), None).map_err(species_error)?);
+        let tree = match grown {
+            Some(t) => t,
+            None => Self::grow(scene, i, st, others)?,
+        };
         let software = ctx.summary.device_type == "Cpu";
         let gpu = match st.backend {
             BackendChoice::Auto => !software && entry.gpu.is_some(),

@@ -52,12 +52,21 @@ impl World {
     }
 
     fn build_all(&mut self) -> Result<Vec<WorldTree>, RuntimeError> {
-        (0..self.scene.trees.len())
-            .map(|i| {
-                let st = self.scene.trees[i].clone();
-                WorldTree::build(&self.ctx, &self.registry, &self.scene, i, &st, &mut self.wind, self.dt)
-            })
-            .collect()
+        // Every tree is grown and the scene's size checked before anything is set up.
+        let mut grown = Vec::with_capacity(self.scene.trees.len());
+        let mut total = 0usize;
+        for (i, st) in self.scene.trees.iter().enumerate() {
+            let tree = WorldTree::grow(&self.scene, i, st, total)?;
+            total += (tree.segments.len() + tree.leaves.len()) * (1 + st.copies.len());
+            grown.push(tree);
+        }
+        let mut built = Vec::with_capacity(grown.len());
+        for (i, tree) in grown.into_iter().enumerate() {
+            let st = self.scene.trees[i].clone();
+            let (ctx, registry, scene) = (&self.ctx, &self.registry, &self.scene);
+            built.push(WorldTree::build(ctx, registry, scene, i, &st, &mut self.wind, self.dt, Some(tree), 0)?);
+        }
+        Ok(built)
     }
 
     /// The device.
@@ -207,7 +216,9 @@ impl World {
         })?;
         scene.check_methods(&self.registry.names())?;
         let st = scene.trees[i].clone();
-        let mut tree = WorldTree::build(&self.ctx, &self.registry, &scene, i, &st, &mut self.wind, self.dt)?;
+        let others = self.trees.iter().enumerate().filter(|(k, _)| *k != i).map(|(_, t)| t.scene_elements()).sum();
+        let mut tree =
+            WorldTree::build(&self.ctx, &self.registry, &scene, i, &st, &mut self.wind, self.dt, None, others)?;
         tree.start_at(&self.ctx, self.dt, self.time);
         self.trees[i] = tree;
         self.scene = scene;

@@ -295,7 +295,10 @@ impl TreeBuilder {
         }
 
         let children = build_children(&seg.parent, &leaves.segment);
-        let levels = seg.level.iter().copied().max().map_or(0, |l| l + 1);
+        let levels = match seg.level.iter().copied().max() {
+            None => 0,
+            Some(l) => l.checked_add(1).ok_or(ModelError::TooLarge { what: "branch levels", count: 256 })?,
+        };
         let tree = Tree { name: name.to_string(), seed, levels, segments: seg, stems, leaves, children, wood };
         tree.validate()?;
         Ok(tree)

@@ -1,7 +1,8 @@
-//! CPU twins of `pose_accumulate.wgsl` and `pose_positions.wgsl`: forward
-//! kinematics by ancestor walks (see [`crate::pose`]). Every segment walks its own chain,
-//! in parallel, exactly as a GPU invocation does. `pose_level.wgsl`'s twin,
-//! [`pose_level`], is the level-by-level alternative (one dispatch per depth).
+//! Forward kinematics (see [`crate::pose`]). The CPU runs [`pose_forward`] and
+//! [`positions_forward`]: one pass in topological order, linear in the segment count at any
+//! depth. The GPU kernels' twins: `pose_accumulate.wgsl` and `pose_positions.wgsl` (every
+//! segment walks its own ancestor chain, in parallel, as a GPU invocation does) and
+//! `pose_level.wgsl`'s [`pose_level`] (one dispatch per depth).
 
 use crate::model::NONE;
 use glam::{Quat, Vec3};
@@ -79,6 +80,67 @@ pub fn pose_level(
         disp[i] = d.extend(0.0).to_array();
         joints[i] = (v3(rest[i]) + d).extend(0.0).to_array();
     }
+}
+
+/// Forward kinematics in one pass in topological order (every parent before its
+/// children, as a [`crate::model::Tree`] stores its segments): linear in the segment count
+/// whatever the depth, where the ancestor walks cost segments × depth. The same numbers as
+/// [`pose_level`] over the depth buckets, bit for bit. Instance-major buffers (`instance ×
+/// segments + segment`); instances run in parallel. What the CPU methods and the pose seam
+/// use; the ancestor walks stay as the twins of the GPU kernels.
+pub fn pose_forward(
+    parent: &[u32],
+    rest: &[[f32; 4]],
+    delta: &[[f32; 4]],
+    acc: &mut [[f32; 4]],
+    joints: &mut [[f32; 4]],
+) {
+    let n = parent.len();
+    if n == 0 {
+        return;
+    }
+    acc.par_chunks_mut(n).zip(joints.par_chunks_mut(n)).zip(delta.par_chunks(n)).for_each(|((acc, joints), delta)| {
+        let mut disp = vec![Vec3::ZERO; n];
+        for i in 0..n {
+            let p = parent[i];
+            if p == NONE {
+                acc[i] = delta[i];
+            } else {
+                let p = p as usize;
+                let ap = Quat::from_array(acc[p]);
+                acc[i] = (ap * Quat::from_array(delta[i])).to_array();
+                let off = v3(rest[i]) - v3(rest[p]);
+                disp[i] = disp[p] + (ap * off - off);
+            }
+            joints[i] = (v3(rest[i]) + disp[i]).extend(0.0).to_array();
+        }
+    });
+}
+
+/// Joint positions from accumulated rotations `D` in one pass in topological order (as
+/// [`pose_forward`]; the same numbers as [`pose_positions`] up to the order of the sum):
+/// `disp_i = disp_parent + (D_parent · o_i − o_i)`. Instance-major, instances in parallel.
+pub fn positions_forward(parent: &[u32], rest: &[[f32; 4]], acc: &[[f32; 4]], joints: &mut [[f32; 4]]) {
+    let n = parent.len();
+    if n == 0 {
+        return;
+    }
+    joints.par_chunks_mut(n).zip(acc.par_chunks(n)).for_each(|(joints, acc)| {
+        let mut disp = vec![Vec3::ZERO; n];
+        for i in 0..n {
+            let p = parent[i];
+            if p != NONE {
+                let p = p as usize;
+                let off = v3(rest[i]) - v3(rest[p]);
+                disp[i] = disp[p] + (Quat::from_array(acc[p]) * off - off);
+            }
+            joints[i] = (v3(rest[i]) + disp[i]).extend(0.0).to_array();
+        }
+    });
+}
+
+fn v3(a: [f32; 4]) -> Vec3 {
+    Vec3::new(a[0], a[1], a[2])
 }
 
 /// Segments grouped by depth, root first (the buckets of [`pose_level`]).

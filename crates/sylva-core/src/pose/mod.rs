@@ -10,9 +10,10 @@
 //!
 //! Written as displacements, the rest pose is reproduced bit for bit when every `δ` is the
 //! identity (zero wind). Zioma's rule "per-branch angles → quaternions concatenated from the
-//! root down" is exactly `D`. The CPU ([`fk`]) and GPU (`pose_accumulate.wgsl`,
-//! `pose_positions.wgsl`) both let each segment walk its ancestor chain, so no pass waits on
-//! another level.
+//! root down" is exactly `D`. The CPU ([`fk::pose_forward`]) makes one pass in topological
+//! order, linear in the segments at any depth; the GPU (`pose_accumulate.wgsl`,
+//! `pose_positions.wgsl`) lets each segment walk its ancestor chain, so no pass waits on
+//! another level, or goes level by level (`pose_level.wgsl`) for deep trees.
 //!
 //! The seam's buffers ([`SeamPose`]: joints and `D`, instance-major) are what meshers and
 //! skinning read; a [`Pose`] is the same with world orientations, plus animated Bézier
@@ -141,14 +142,14 @@ impl SeamPose {
 }
 
 /// The pose seam's buffers from rotations `δ`, instance-major: joint positions (w = 0) and
-/// accumulated rotations `D`, by forward kinematics (ancestor walks, rayon). What meshers and
-/// skinning read; [`Pose`] is the same data with world orientations.
+/// accumulated rotations `D`, by forward kinematics ([`fk::pose_forward`]: one pass in
+/// topological order per instance, instances in parallel). What meshers and skinning read;
+/// [`Pose`] is the same data with world orientations.
 pub fn seam_buffers(tree: &Tree, delta: &[[f32; 4]]) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
     let mut acc = vec![[0.0f32; 4]; delta.len()];
-    crate::pose::fk::pose_accumulate(&tree.segments.parent, delta, &mut acc);
     let mut joints = vec![[0.0f32; 4]; delta.len()];
     let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
-    crate::pose::fk::pose_positions(&tree.segments.parent, &rest, &acc, &mut joints);
+    fk::pose_forward(&tree.segments.parent, &rest, delta, &mut acc, &mut joints);
     (joints, acc)
 }
 

@@ -229,8 +229,8 @@ pub enum WindError {
     #[error("{file}:{line}:{column}: {message}")]
     Toml { file: String, line: usize, column: usize, message: String },
     /// A value out of range.
-    #[error("{file}: field[{index}].{field}: {message}")]
-    Value { file: String, index: usize, field: &'static str, message: String },
+    #[error("{file}:{line}: field[{index}].{field}: {message}")]
+    Value { file: String, line: usize, index: usize, field: &'static str, message: String },
     /// The file could not be read or written.
     #[error("{file}: {message}")]
     Io { file: String, message: String },
@@ -294,14 +294,12 @@ impl WindScene {
     /// Parses TOML; `file` names it in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<Self, WindError> {
         let scene: WindScene = toml::from_str(text).map_err(|e| {
-            let offset = e.span().map_or(0, |s| s.start);
-            let before = &text[..offset.min(text.len())];
-            let line = before.matches('\n').count() + 1;
-            let column = before.rfind('\n').map_or(before.len(), |i| before.len() - i - 1) + 1;
-            WindError::Toml { file: file.to_string(), line, column, message: e.message().trim().to_string() }
+            let (line, column, message) = crate::io::toml_error(text, &e);
+            WindError::Toml { file: file.to_string(), line, column, message }
         })?;
         scene.check().map_err(|(index, field, message)| WindError::Value {
             file: file.to_string(),
+            line: crate::io::field_line(text, &format!("field[{index}].{field}")),
             index,
             field,
             message,

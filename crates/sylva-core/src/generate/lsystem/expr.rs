@@ -153,7 +153,12 @@ impl Expr {
                     Func::Min => a(0).min(a(1)),
                     Func::Max => a(0).max(a(1)),
                     Func::Pow => a(0).powf(a(1)),
-                    Func::Clamp => a(0).clamp(a(1).min(a(2)), a(2).max(a(1))),
+                    Func::Clamp => {
+                        // Bounds in either order; NaN bounds give NaN (f64::clamp panics on them),
+                        // which the turtle then refuses where the value is used.
+                        let (lo, hi) = (a(1).min(a(2)), a(2).max(a(1)));
+                        if lo.is_nan() || hi.is_nan() { f64::NAN } else { a(0).clamp(lo, hi) }
+                    }
                 }
             }
         }

@@ -72,7 +72,7 @@ pub enum GrammarError {
     #[error("{file}:{line}: `{field}`: {message}")]
     Value { file: String, line: usize, field: String, message: String },
     /// A parser limit was hit.
-    #[error("{file}:{line}:{column}: limit `{limit}` = {value} exceeded")]
+    #[error("{file}:{line}:{column}: limit `{limit}` = {value} exceeded (raise it with --{})", limit.replace('_', "-"))]
     Limit { file: String, line: usize, column: usize, limit: &'static str, value: usize },
     /// The file could not be read.
     #[error("{file}: {message}")]
@@ -91,6 +91,9 @@ pub enum LSystemError {
     /// The turtle met something it cannot draw.
     #[error("{file}: turtle, module {module} (`{symbol}`): {message}")]
     Turtle { file: String, module: usize, symbol: char, message: String },
+    /// The turtle drew no segment: there is no tree to build.
+    #[error("{file}: the derived string draws no segment (no `F` reached the turtle); a tree needs at least one")]
+    NoSegments { file: String },
     /// The resulting tree broke a model invariant.
     #[error("{file}: {source}")]
     Model { file: String, source: ModelError },
@@ -183,6 +186,9 @@ impl Grammar {
         let s = self.derive(opts)?;
         let builder = turtle::interpret(self, &s, &opts.limits)?;
         drop(s);
+        if builder.segments.is_empty() {
+            return Err(LSystemError::NoSegments { file: self.file.clone() });
+        }
         builder
             .build(&self.name, opts.seed, self.wood)
             .map_err(|source| LSystemError::Model { file: self.file.clone(), source })

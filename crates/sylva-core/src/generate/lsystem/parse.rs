@@ -142,7 +142,15 @@ fn modules<S: Scope>(p: &mut ExprParser<'_, S>) -> Result<Vec<(u8, Vec<Expr>)>, 
         if p.src.get(p.pos) == Some(&b'(') {
             p.pos += 1;
             loop {
-                args.push(p.expr()?);
+                let start = p.pos;
+                let e = p.expr()?;
+                if let Expr::Num(v) = e
+                    && !v.is_finite()
+                {
+                    p.pos = start;
+                    return Err(p.error(&format!("a finite parameter (this one evaluates to {v})")));
+                }
+                args.push(e);
                 match p.peek() {
                     Some(b',') => p.pos += 1,
                     Some(b')') => {

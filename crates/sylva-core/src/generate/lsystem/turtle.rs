@@ -30,7 +30,7 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
     b.segments.reserve_exact(draws);
     b.stems.reserve(draws / 2);
     let mut st = State { pos: DVec3::ZERO, q: DQuat::IDENTITY, width: g.width, stem: None, attach: None };
-    let mut stack: Vec<State> = Vec::new();
+    let mut stack: Vec<(usize, State)> = Vec::new();
     let mut segments = 0usize;
     let err = |i: usize, sym: u8, message: String| LSystemError::Turtle {
         file: g.file.clone(),
@@ -79,7 +79,20 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
                     }
                     None => {
                         let (parent, level) = match st.attach {
-                            Some((ps, pseg)) => (Some((ps, pseg, 1.0)), b.stems[ps].level.saturating_add(1)),
+                            Some((ps, pseg)) => match b.stems[ps].level.checked_add(1).filter(|&l| l < u8::MAX) {
+                                Some(level) => (Some((ps, pseg, 1.0)), level),
+                                None => {
+                                    return Err(err(
+                                        i,
+                                        sym,
+                                        format!(
+                                            "a branch {} levels deep; a tree holds at most {} levels of branches",
+                                            u16::from(b.stems[ps].level) + 2,
+                                            u8::MAX
+                                        ),
+                                    ));
+                                }
+                            },
                             None => (None, 0),
                         };
                         b.add_stem(parent, level)
@@ -125,11 +138,11 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
                 if stack.len() >= limits.max_branch_depth {
                     return Err(limit("max_branch_depth", limits.max_branch_depth));
                 }
-                stack.push(st);
+                stack.push((i, st));
                 st.stem = None;
             }
             b']' => match stack.pop() {
-                Some(prev) => st = prev,
+                Some((_, prev)) => st = prev,
                 None => return Err(err(i, sym, "`]` without a matching `[`".into())),
             },
             b'~' => {
@@ -148,6 +161,10 @@ pub(super) fn interpret(g: &Grammar, s: &LString, limits: &Limits) -> Result<Tre
             }
             _ => {}
         }
+    }
+    if let Some(&(i, _)) = stack.last() {
+        let n = stack.len();
+        return Err(err(i, b'[', format!("{n} `[` left without a matching `]` at the end of the string")));
     }
     Ok(b)
 }

@@ -250,8 +250,7 @@ impl Method for Akagi {
                 &mut state.omega,
                 &mut delta,
             );
-            crate::pose::fk::pose_accumulate(&tree.segments.parent, &delta, &mut state.acc);
-            crate::pose::fk::pose_positions(&tree.segments.parent, &self.rest, &state.acc, &mut joints);
+            crate::pose::fk::pose_forward(&tree.segments.parent, &self.rest, &delta, &mut state.acc, &mut joints);
             state.time = t;
         }
         for (i, j) in joints.iter().enumerate() {

@@ -522,14 +522,14 @@ impl Method for Hsm {
     fn seam(&self, tree: &Tree, _wind: &PackedWind, state: &HsmState, out: &mut SeamPose) {
         out.acc = self.rotations(state);
         out.joints.resize(out.acc.len(), [0.0; 4]);
-        crate::pose::fk::pose_positions(&tree.segments.parent, &self.rest_joints, &out.acc, &mut out.joints);
+        crate::pose::fk::positions_forward(&tree.segments.parent, &self.rest_joints, &out.acc, &mut out.joints);
     }
 
     /// Segments turned by their clusters' rotations, joints by forward kinematics.
     fn pose(&self, tree: &Tree, _wind: &PackedWind, state: &HsmState) -> Pose {
         let acc = self.rotations(state);
         let mut joints = vec![[0.0f32; 4]; acc.len()];
-        crate::pose::fk::pose_positions(&tree.segments.parent, &self.rest_joints, &acc, &mut joints);
+        crate::pose::fk::positions_forward(&tree.segments.parent, &self.rest_joints, &acc, &mut joints);
         Pose {
             start: joints.iter().map(|j| Vec3::new(j[0], j[1], j[2])).collect(),
             orientation: acc
