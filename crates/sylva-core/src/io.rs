@@ -32,6 +32,14 @@ pub fn abandon_pending() -> usize {
     removed
 }
 
+/// Forgets a temporary path (its owner removed or committed it).
+fn deregister(tmp: &Path) {
+    let mut list = pending();
+    if let Some(i) = list.iter().rposition(|p| p == tmp) {
+        list.swap_remove(i);
+    }
+}
+
 fn refuse_if_abandoned(tmp: &Path) -> io::Result<()> {
     if ABANDONED.load(Ordering::SeqCst) {
         let _ = if tmp.is_dir() { fs::remove_dir_all(tmp) } else { fs::remove_file(tmp) };
@@ -110,10 +118,7 @@ impl Drop for PendingFile {
         if !self.done {
             let _ = fs::remove_file(&self.tmp);
         }
-        let mut list = pending();
-        if let Some(i) = list.iter().rposition(|p| *p == self.tmp) {
-            list.swap_remove(i);
-        }
+        deregister(&self.tmp);
     }
 }
 
@@ -173,10 +178,7 @@ impl Drop for PendingDir {
         if !self.done {
             let _ = fs::remove_dir_all(&self.tmp);
         }
-        let mut list = pending();
-        if let Some(i) = list.iter().rposition(|p| *p == self.tmp) {
-            list.swap_remove(i);
-        }
+        deregister(&self.tmp);
     }
 }
 

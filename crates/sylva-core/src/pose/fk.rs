@@ -99,21 +99,11 @@ pub fn pose_forward(
     if n == 0 {
         return;
     }
+    // Every segment in index order is a single bucket that respects parents first.
+    let order: Vec<u32> = (0..n as u32).collect();
     acc.par_chunks_mut(n).zip(joints.par_chunks_mut(n)).zip(delta.par_chunks(n)).for_each(|((acc, joints), delta)| {
-        let mut disp = vec![Vec3::ZERO; n];
-        for i in 0..n {
-            let p = parent[i];
-            if p == NONE {
-                acc[i] = delta[i];
-            } else {
-                let p = p as usize;
-                let ap = Quat::from_array(acc[p]);
-                acc[i] = (ap * Quat::from_array(delta[i])).to_array();
-                let off = v3(rest[i]) - v3(rest[p]);
-                disp[i] = disp[p] + (ap * off - off);
-            }
-            joints[i] = (v3(rest[i]) + disp[i]).extend(0.0).to_array();
-        }
+        let mut disp = vec![[0.0f32; 4]; n];
+        pose_level(&order, parent, rest, delta, acc, &mut disp, joints);
     });
 }
 
