@@ -258,7 +258,7 @@ impl WorldTree {
         Ok(tree)
     }
 
-    fn elements(tree: &Tree, instances: usize) -> usize {
+    pub(crate) fn elements(tree: &Tree, instances: usize) -> usize {
         (tree.segments.len() + tree.leaves.len()).saturating_mul(instances.max(1))
     }
 

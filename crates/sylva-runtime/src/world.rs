@@ -57,7 +57,7 @@ impl World {
         let mut total = 0usize;
         for (i, st) in self.scene.trees.iter().enumerate() {
             let tree = WorldTree::grow(&self.scene, i, st, total)?;
-            total += (tree.segments.len() + tree.leaves.len()) * (1 + st.copies.len());
+            total += WorldTree::elements(&tree, 1 + st.copies.len());
             grown.push(tree);
         }
         let mut built = Vec::with_capacity(grown.len());
