@@ -56,7 +56,8 @@ fn random_rotations(n: usize, seed: u64) -> Vec<[f32; 4]> {
 #[test]
 fn one_pass_forward_kinematics_matches_the_gpu_kernels_twins() {
     use sylva_core::pose::fk::{
-        depth_buckets, pose_accumulate, pose_forward, pose_level, pose_positions, positions_forward,
+        depth_buckets, jump_ancestors, pose_accumulate, pose_forward, pose_jump, pose_level, pose_positions,
+        positions_forward,
     };
     let deep = Grammar::parse("iterations: 900\naxiom: A\nA -> F/(37)&(1)A\n", "stem.lsys")
         .unwrap()
@@ -96,7 +97,51 @@ fn one_pass_forward_kinematics_matches_the_gpu_kernels_twins() {
         let mut pj = vec![[0.0f32; 4]; n * instances];
         positions_forward(parent, &rest, &acc, &mut pj);
         assert_eq!(pj, joints, "{name}: positions_forward");
+        // Pointer jumping (the deep-hierarchy GPU kernels' twins): ⌈log₂(depth + 1)⌉ rounds,
+        // each pointer twice as far up, and the same pose to the walks' tolerance.
+        let rounds = jump_ancestors(parent);
+        let depth = depth_buckets(parent).len() - 1;
+        assert_eq!(rounds.len(), (depth + 1).next_power_of_two().trailing_zeros() as usize, "{name}: rounds");
+        let (mut ja, mut jj) = (vec![[0.0f32; 4]; n * instances], vec![[0.0f32; 4]; n * instances]);
+        pose_jump(&rounds, parent, &rest, &delta, &mut ja, &mut jj);
+        for i in 0..n * instances {
+            let dq = (Quat::from_array(acc[i]).dot(Quat::from_array(ja[i])).abs() - 1.0).abs();
+            assert!(dq < 1e-5, "{name}: segment {i}: jumped rotations differ by {dq}");
+            let dj = (Vec3::from_slice(&joints[i][..3]) - Vec3::from_slice(&jj[i][..3])).length();
+            assert!(
+                dj < 1e-5 * height * (1.0 + n as f32 / 100.0),
+                "{name}: segment {i}: jumped joints differ by {dj} m"
+            );
+        }
+        let identity = vec![[0.0f32, 0.0, 0.0, 1.0]; n * instances];
+        pose_jump(&rounds, parent, &rest, &identity, &mut ja, &mut jj);
+        assert!(jj.chunks(n).all(|c| c == rest.as_slice()), "{name}: identity rotations give the rest joints exactly");
     }
+}
+
+/// Pointer jumping's ancestor lists: round k points 2^k levels up, or nowhere past the root.
+#[test]
+fn pointer_jumping_points_twice_as_far_each_round() {
+    use sylva_core::model::NONE;
+    let t = tree("weeping_willow");
+    let parent = &t.segments.parent;
+    let up = |mut i: u32, levels: usize| {
+        for _ in 0..levels {
+            if i == NONE {
+                break;
+            }
+            i = parent[i as usize];
+        }
+        i
+    };
+    let rounds = sylva_core::pose::fk::jump_ancestors(parent);
+    assert!(rounds.len() >= 5, "the willow is more than 16 levels deep");
+    for (k, anc) in rounds.iter().enumerate() {
+        for (i, &a) in anc.iter().enumerate() {
+            assert_eq!(a, up(i as u32, 1 << k), "round {k}, segment {i}");
+        }
+    }
+    assert!(rounds.last().unwrap().iter().any(|&a| a != NONE), "no round is spent on nothing");
 }
 
 #[test]

@@ -29,6 +29,14 @@ pub const POSE_ACCUMULATE: &str = include_str!("pose/pose_accumulate.wgsl");
 pub const POSE_POSITIONS: &str = include_str!("pose/pose_positions.wgsl");
 /// Kernel: one depth of forward kinematics, root first (the level-by-level alternative).
 pub const POSE_LEVEL: &str = include_str!("pose/pose_level.wgsl");
+/// Kernel: one round of pointer jumping over rotations (deep hierarchies).
+pub const POSE_JUMP_ROTATIONS: &str = include_str!("pose/pose_jump_rotations.wgsl");
+/// Kernel: each segment's displacement of its subtree, from accumulated rotations.
+pub const POSE_JUMP_TERMS: &str = include_str!("pose/pose_jump_terms.wgsl");
+/// Kernel: one round of pointer jumping over displacements.
+pub const POSE_JUMP_SUMS: &str = include_str!("pose/pose_jump_sums.wgsl");
+/// Kernel: joints from rest joints and summed displacements.
+pub const POSE_JUMP_JOINTS: &str = include_str!("pose/pose_jump_joints.wgsl");
 /// Kernel: Zioma's per-segment rotations.
 pub const ZIOMA_ROTATIONS: &str = include_str!("methods/zioma/zioma_rotations.wgsl");
 /// Kernel: trunk noise bands at many (t, tree) samples.
@@ -106,6 +114,10 @@ kernels! {
     pose_accumulate: [QUAT, TREE, POSE_ACCUMULATE] => sylva_core::pose::fk::pose_accumulate;
     pose_positions: [QUAT, TREE, POSE_POSITIONS] => sylva_core::pose::fk::pose_positions;
     pose_level: [QUAT, TREE, POSE_LEVEL] => sylva_core::pose::fk::pose_level;
+    pose_jump_rotations: [QUAT, TREE, POSE_JUMP_ROTATIONS] => sylva_core::pose::fk::pose_jump_rotations;
+    pose_jump_terms: [QUAT, TREE, POSE_JUMP_TERMS] => sylva_core::pose::fk::pose_jump_terms;
+    pose_jump_sums: [TREE, POSE_JUMP_SUMS] => sylva_core::pose::fk::pose_jump_sums;
+    pose_jump_joints: [POSE_JUMP_JOINTS] => sylva_core::pose::fk::pose_jump_joints;
     trunk_noise: [NOISE, TRUNK_NOISE] => sylva_core::methods::zioma::trunk::trunk_noise;
     zioma_rotations: [QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS] => sylva_core::methods::zioma::rotations::zioma_rotations;
     akagi_forces: [QUAT, TREE, NOISE, WIND, AKAGI, AKAGI_FORCES] => sylva_core::methods::akagi::kernels::akagi_forces;

@@ -93,13 +93,106 @@ fn forward_kinematics_matches_on_random_rotations() {
             bezier: None,
         };
         compare(&t, &twin, &gpu, &format!("{name} level-by-level twin"));
+        // Pointer jumping: the same pose to rounding (products and sums in a tree of pairs).
+        let jump = GpuPose::with_strategy(ctx, &t, FkStrategy::PointerJump).unwrap();
+        let worst = compare(&t, &cpu, &jump.pose_from_rotations(ctx, &delta).unwrap(), &format!("{name} jumping"));
+        println!("fk {name} pointer jumping: worst joint difference {worst:.2e} × height");
     }
     // Identity rotations give the rest pose exactly either way.
     let t = SpeciesSource::resolve("quaking_aspen").unwrap().generate(1, &Default::default(), None).unwrap();
     let identity = vec![[0.0f32, 0.0, 0.0, 1.0]; t.segments.len()];
-    for strategy in [FkStrategy::AncestorWalk, FkStrategy::LevelByLevel] {
-        let gpu = GpuPose::with_strategy(ctx, &t, strategy).unwrap().pose_from_rotations(ctx, &identity).unwrap();
+    for strategy in [FkStrategy::AncestorWalk, FkStrategy::LevelByLevel, FkStrategy::PointerJump] {
+        let pose = GpuPose::with_strategy(ctx, &t, strategy).unwrap();
+        assert_eq!(pose.strategy(), strategy);
+        let gpu = pose.pose_from_rotations(ctx, &identity).unwrap();
         assert_eq!(gpu.start, t.segments.start, "{strategy:?}");
+    }
+}
+
+/// Deep hierarchies jump pointers (`FkStrategy::for_tree`): a 900-segment stem with random
+/// rotations, three instances, against pointer jumping's CPU twin (the same products and sums
+/// in the same tree of pairs; glam and `quat.wgsl` round a product differently, and a chain
+/// of 900 compounds it: within 2e-5 × height and 2e-5 per quaternion component; lavapipe
+/// measures 4e-6) and against
+/// the CPU's one pass (another order: within 1e-4 × height, the parity bound). The
+/// joints-only path (HSM's) as well.
+#[test]
+fn pointer_jumping_matches_on_a_deep_stem() {
+    use sylva_core::pose::fk::{jump_ancestors, pose_forward, pose_jump, pose_jump_joints, pose_jump_sums};
+    use sylva_core::pose::fk::{pose_jump_terms, positions_forward};
+    use sylva_gpu::kernel::read_back;
+    let Some(ctx) = common::gpu() else { return };
+    let t = sylva_core::Grammar::parse("iterations: 900\naxiom: A\nA -> F/(37)&(1)A\n", "stem.lsys")
+        .unwrap()
+        .generate(&Default::default())
+        .unwrap();
+    let (n, instances) = (t.segments.len(), 3);
+    assert_eq!(FkStrategy::for_tree(&t.segments.parent), FkStrategy::PointerJump);
+    let willow = SpeciesSource::resolve("weeping_willow").unwrap().generate(1, &Default::default(), None).unwrap();
+    assert_eq!(FkStrategy::for_tree(&willow.segments.parent), FkStrategy::AncestorWalk, "shipped species walk");
+    let pose = GpuPose::with_instances(ctx, &t, instances).unwrap();
+    assert_eq!(pose.strategy(), FkStrategy::PointerJump);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(13);
+    let delta: Vec<[f32; 4]> = (0..n * instances)
+        .map(|_| {
+            let axis = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            Quat::from_axis_angle(axis.normalize_or(Vec3::X), rng.random_range(-0.05..0.05)).to_array()
+        })
+        .collect();
+    ctx.queue.write_buffer(pose.delta_buffer(), 0, bytemuck::cast_slice(&delta));
+    let mut e = ctx.device.create_command_encoder(&Default::default());
+    pose.record(ctx, &mut e);
+    ctx.queue.submit([e.finish()]);
+    let gpu_acc: Vec<[f32; 4]> = read_back(ctx, pose.acc_buffer(), n * instances).unwrap();
+    let gpu_joints: Vec<[f32; 4]> = read_back(ctx, pose.joints_buffer(), n * instances).unwrap();
+    let parent = &t.segments.parent;
+    let rest: Vec<[f32; 4]> = t.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
+    let total = n * instances;
+    let (mut twin_acc, mut twin_joints) = (vec![[0.0f32; 4]; total], vec![[0.0f32; 4]; total]);
+    pose_jump(&jump_ancestors(parent), parent, &rest, &delta, &mut twin_acc, &mut twin_joints);
+    let (mut one_acc, mut one_joints) = (vec![[0.0f32; 4]; total], vec![[0.0f32; 4]; total]);
+    pose_forward(parent, &rest, &delta, &mut one_acc, &mut one_joints);
+    let height = t.height();
+    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let q = |a: [f32; 4]| Quat::from_array(a);
+    let (mut worst_twin, mut worst_one) = (0.0f32, 0.0f32);
+    for i in 0..total {
+        let (dt, d1) =
+            ((v(gpu_joints[i]) - v(twin_joints[i])).length(), (v(gpu_joints[i]) - v(one_joints[i])).length());
+        worst_twin = worst_twin.max(dt / height);
+        worst_one = worst_one.max(d1 / height);
+        assert!(dt <= 2e-5 * height, "segment {i}: GPU joint {dt} m from its twin");
+        assert!(d1 <= 1e-4 * height, "segment {i}: GPU joint {d1} m from the CPU's one pass");
+        let dq = glam::Vec4::from(q(gpu_acc[i]) - q(twin_acc[i])).abs().max_element();
+        assert!(dq <= 2e-5, "segment {i}: rotation vs twin: {dq}, {:?} vs {:?}", gpu_acc[i], twin_acc[i]);
+        assert!(angle(q(gpu_acc[i]), q(one_acc[i])) <= 1e-4, "segment {i}: rotation vs one pass");
+    }
+    // Instances are independent: each one's pose is its own rotations'.
+    assert_ne!(gpu_joints[n - 1], gpu_joints[2 * n - 1], "instances differ");
+    println!(
+        "pointer jumping, 900-segment stem × 3: worst joint {worst_twin:.2e} × height from its twin, {worst_one:.2e} from the one pass"
+    );
+
+    // Joints only, from rotations written into acc (HSM's path).
+    ctx.queue.write_buffer(pose.acc_buffer(), 0, bytemuck::cast_slice(&one_acc));
+    let mut e = ctx.device.create_command_encoder(&Default::default());
+    pose.record_positions(ctx, &mut e);
+    ctx.queue.submit([e.finish()]);
+    let gpu_joints: Vec<[f32; 4]> = read_back(ctx, pose.joints_buffer(), total).unwrap();
+    let mut terms = vec![[0.0f32; 4]; total];
+    pose_jump_terms(parent, &rest, &one_acc, &mut terms);
+    for anc in jump_ancestors(parent) {
+        let mut next = vec![[0.0f32; 4]; total];
+        pose_jump_sums(&anc, &terms, &mut next);
+        terms = next;
+    }
+    let mut twin = vec![[0.0f32; 4]; total];
+    pose_jump_joints(&rest, &terms, &mut twin);
+    let mut one = vec![[0.0f32; 4]; total];
+    positions_forward(parent, &rest, &one_acc, &mut one);
+    for i in 0..total {
+        assert!((v(gpu_joints[i]) - v(twin[i])).length() <= 2e-5 * height, "positions, segment {i}: vs twin");
+        assert!((v(gpu_joints[i]) - v(one[i])).length() <= 1e-4 * height, "positions, segment {i}: vs one pass");
     }
 }
 

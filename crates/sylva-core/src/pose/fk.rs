@@ -2,7 +2,9 @@
 //! [`positions_forward`]: one pass in topological order, linear in the segment count at any
 //! depth. The GPU kernels' twins: `pose_accumulate.wgsl` and `pose_positions.wgsl` (every
 //! segment walks its own ancestor chain, in parallel, as a GPU invocation does) and
-//! `pose_level.wgsl`'s [`pose_level`] (one dispatch per depth).
+//! `pose_level.wgsl`'s [`pose_level`] (one dispatch per depth), and for deep hierarchies
+//! pointer jumping ([`pose_jump`]: `pose_jump_*.wgsl`, ⌈log₂(depth + 1)⌉ dispatches for the
+//! rotations and as many for the joints).
 
 use crate::model::NONE;
 use glam::{Quat, Vec3};
@@ -147,4 +149,102 @@ pub fn depth_buckets(parent: &[u32]) -> Vec<Vec<u32>> {
         buckets[depth[i]].push(i as u32);
     }
     buckets
+}
+
+/// The ancestors pointer jumping reads, one list per round: round 0 reads the parents, round
+/// `k + 1` reads `anc_k[anc_k[i]]` (the ancestor 2^(k+1) levels up), and the rounds stop when
+/// every entry is [`NONE`]: ⌈log₂(depth + 1)⌉ rounds for a hierarchy `depth` levels deep.
+/// They depend on the hierarchy alone, so they are made once, beside the tree.
+pub fn jump_ancestors(parent: &[u32]) -> Vec<Vec<u32>> {
+    let mut rounds = Vec::new();
+    let mut anc = parent.to_vec();
+    while anc.iter().any(|&a| a != NONE) {
+        let next = anc.iter().map(|&a| if a == NONE { NONE } else { anc[a as usize] }).collect();
+        rounds.push(std::mem::replace(&mut anc, next));
+    }
+    rounds
+}
+
+/// One round of pointer jumping over rotations: `out[i] = in[anc[i]] · in[i]` (or `in[i]`
+/// where `anc[i]` is [`NONE`]). Starting from δ, after every round of [`jump_ancestors`]
+/// `out = acc` (as [`pose_accumulate`], multiplied in a tree of pairs rather than a chain).
+/// Bindings: 0 anc, 1 in, 2 out; instance-major `in`/`out` (`anc` holds one instance).
+pub fn pose_jump_rotations(anc: &[u32], input: &[[f32; 4]], out: &mut [[f32; 4]]) {
+    let n = anc.len();
+    out.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, o)| {
+        let base = i / n * n;
+        let a = anc[i - base];
+        *o = if a == NONE {
+            input[i]
+        } else {
+            (Quat::from_array(input[base + a as usize]) * Quat::from_array(input[i])).to_array()
+        };
+    });
+}
+
+/// The displacement each segment adds to its subtree's joints: `out[i] = D_parent · o_i − o_i`,
+/// `o_i = rest_i − rest_parent`, zero at a root (the terms [`pose_positions`] sums).
+/// Bindings: 0 parents, 1 rest, 2 acc, 3 out; instance-major `acc`/`out`.
+pub fn pose_jump_terms(parent: &[u32], rest: &[[f32; 4]], acc: &[[f32; 4]], out: &mut [[f32; 4]]) {
+    let n = parent.len();
+    out.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, o)| {
+        let base = i / n * n;
+        let l = i - base;
+        let p = parent[l];
+        *o = if p == NONE {
+            [0.0; 4]
+        } else {
+            let off = v3(rest[l]) - v3(rest[p as usize]);
+            (Quat::from_array(acc[base + p as usize]) * off - off).extend(0.0).to_array()
+        };
+    });
+}
+
+/// One round of pointer jumping over displacements: `out[i] = in[anc[i]] + in[i]` (or
+/// `in[i]` at [`NONE`]). Bindings: 0 anc, 1 in, 2 out; instance-major `in`/`out`.
+pub fn pose_jump_sums(anc: &[u32], input: &[[f32; 4]], out: &mut [[f32; 4]]) {
+    let n = anc.len();
+    out.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, o)| {
+        let base = i / n * n;
+        let a = anc[i - base];
+        *o = if a == NONE { input[i] } else { (v3(input[base + a as usize]) + v3(input[i])).extend(0.0).to_array() };
+    });
+}
+
+/// Joints from summed displacements: `joints[i] = rest[i] + disp[i]`, so identity rotations
+/// give the rest pose exactly. Bindings: 0 rest, 1 disp, 2 joints; instance-major
+/// `disp`/`joints`.
+pub fn pose_jump_joints(rest: &[[f32; 4]], disp: &[[f32; 4]], joints: &mut [[f32; 4]]) {
+    let n = rest.len();
+    joints.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, o)| {
+        *o = (v3(rest[i % n]) + v3(disp[i])).extend(0.0).to_array();
+    });
+}
+
+/// Forward kinematics by pointer jumping, as the GPU runs it for deep hierarchies
+/// (`sylva_gpu::pose::FkStrategy::PointerJump`): ⌈log₂(depth + 1)⌉ rounds of [`pose_jump_rotations`], [`pose_jump_terms`], as
+/// many rounds of [`pose_jump_sums`], then [`pose_jump_joints`]. Work n·log depth in
+/// 2⌈log₂(depth + 1)⌉ + 2 passes, where ancestor walks do n·depth and level by level makes
+/// `depth` passes. `rounds` from [`jump_ancestors`]; instance-major `delta`, `acc`, `joints`.
+pub fn pose_jump(
+    rounds: &[Vec<u32>],
+    parent: &[u32],
+    rest: &[[f32; 4]],
+    delta: &[[f32; 4]],
+    acc: &mut [[f32; 4]],
+    joints: &mut [[f32; 4]],
+) {
+    let mut a = delta.to_vec();
+    let mut b = vec![[0.0f32; 4]; delta.len()];
+    for anc in rounds {
+        pose_jump_rotations(anc, &a, &mut b);
+        std::mem::swap(&mut a, &mut b);
+    }
+    acc.copy_from_slice(&a);
+    pose_jump_terms(parent, rest, acc, &mut a);
+    for anc in rounds {
+        pose_jump_sums(anc, &a, &mut b);
+        std::mem::swap(&mut a, &mut b);
+    }
+    pose_jump_joints(rest, &a, joints);
 }

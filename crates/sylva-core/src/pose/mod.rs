@@ -13,7 +13,8 @@
 //! root down" is exactly `D`. The CPU ([`fk::pose_forward`]) makes one pass in topological
 //! order, linear in the segments at any depth; the GPU (`pose_accumulate.wgsl`,
 //! `pose_positions.wgsl`) lets each segment walk its ancestor chain, so no pass waits on
-//! another level, or goes level by level (`pose_level.wgsl`) for deep trees.
+//! another level, and jumps pointers (`pose_jump_*.wgsl`, [`fk::pose_jump`]) for
+//! hierarchies too deep to walk; level by level (`pose_level.wgsl`) is the third way.
 //!
 //! The seam's buffers ([`SeamPose`]: joints and `D`, instance-major) are what meshers and
 //! skinning read; a [`Pose`] is the same with world orientations, plus animated Bézier

@@ -12,18 +12,47 @@ use sylva_core::pose::Pose;
 
 /// How forward kinematics walks the hierarchy on the GPU.
 ///
-/// Measured on every preset (`cargo bench -p sylva-gpu --bench animate`, figures in
-/// `docs/PERFORMANCE.md`): the ancestor walk is one pair of dispatches whatever the depth,
-/// and each invocation reads its chain (≤ depth quaternions, cached: siblings share them);
-/// level by level needs one dispatch per depth (37 for the weeping willow) with little work
-/// in each. The walk is the default.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// Measured (`cargo bench -p sylva-gpu --bench animate`, figures in `docs/PERFORMANCE.md`):
+/// the ancestor walk is one pair of dispatches whatever the depth, and each invocation reads
+/// its chain (≤ depth quaternions, cached: siblings share them), so its work grows as
+/// segments × depth. Level by level needs one dispatch per depth. Pointer jumping does
+/// segments × ⌈log₂(depth + 1)⌉ work in 2⌈log₂(depth + 1)⌉ + 2 dispatches.
+/// [`FkStrategy::for_tree`] walks ancestors up to [`FkStrategy::WALK_MAX_DEPTH`] levels (every
+/// shipped species) and jumps pointers beyond.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FkStrategy {
     /// Every segment walks its own ancestor chain (`pose_accumulate`, `pose_positions`).
-    #[default]
     AncestorWalk,
     /// One dispatch per depth, root first (`pose_level`).
     LevelByLevel,
+    /// Pointer jumping: each round doubles how far up every segment has gathered
+    /// (`pose_jump_rotations`, `pose_jump_terms`, `pose_jump_sums`, `pose_jump_joints`).
+    PointerJump,
+}
+
+impl FkStrategy {
+    /// The deepest hierarchy [`FkStrategy::for_tree`] gives to ancestor walks. On lavapipe
+    /// pointer jumping already wins from depth ≈ 30 (`docs/PERFORMANCE.md`); on a discrete
+    /// GPU each of its dispatches costs microseconds while a walk's extra reads are cached,
+    /// so every shipped species (≤ 37 levels) stays on the walk and deep grammars jump.
+    pub const WALK_MAX_DEPTH: usize = 64;
+
+    /// The strategy for a hierarchy, by its depth: ancestor walks up to
+    /// [`Self::WALK_MAX_DEPTH`] levels, pointer jumping beyond.
+    pub fn for_tree(parent: &[u32]) -> Self {
+        if max_depth(parent) <= Self::WALK_MAX_DEPTH { Self::AncestorWalk } else { Self::PointerJump }
+    }
+}
+
+/// The number of levels below the deepest root (0 for roots alone); parents come first.
+pub fn max_depth(parent: &[u32]) -> usize {
+    let mut depth = vec![0usize; parent.len()];
+    for i in 0..parent.len() {
+        if let Some(&d) = depth.get(parent[i] as usize) {
+            depth[i] = d + 1;
+        }
+    }
+    depth.into_iter().max().unwrap_or(0)
 }
 
 /// Uploads depth buckets of segment indices, each padded with `u32::MAX` to a multiple of
@@ -49,8 +78,12 @@ pub struct GpuPose {
     accumulate: Arc<Kernel>,
     positions: Arc<Kernel>,
     level: Arc<Kernel>,
+    jump: [Arc<Kernel>; 4],
     strategy: FkStrategy,
     levels: Vec<(wgpu::Buffer, u32)>,
+    /// Pointer jumping: the ancestors each round reads, and a scratch buffer (instance-major).
+    jumps: Vec<wgpu::Buffer>,
+    scratch: wgpu::Buffer,
     disp: wgpu::Buffer,
     parents: wgpu::Buffer,
     rest: wgpu::Buffer,
@@ -63,9 +96,10 @@ pub struct GpuPose {
 }
 
 impl GpuPose {
-    /// Uploads the tree's hierarchy and rest joints (ancestor walks).
+    /// Uploads the tree's hierarchy and rest joints, walking it as
+    /// [`FkStrategy::for_tree`] chooses by depth.
     pub fn new(ctx: &GpuContext, tree: &Tree) -> Result<Self, GpuError> {
-        Self::with_strategy(ctx, tree, FkStrategy::default())
+        Self::with_strategy(ctx, tree, FkStrategy::for_tree(&tree.segments.parent))
     }
 
     /// Uploads the tree's hierarchy and rest joints, walking the hierarchy as `strategy` says.
@@ -73,28 +107,52 @@ impl GpuPose {
         Self::build(ctx, tree, strategy, 1)
     }
 
-    /// `count` instances of the tree (ancestor walks over instance-major buffers: a
-    /// method writes `instance × segments + segment`).
+    /// `count` instances of the tree over instance-major buffers (a method writes
+    /// `instance × segments + segment`), walked as [`FkStrategy::for_tree`] chooses.
     pub fn with_instances(ctx: &GpuContext, tree: &Tree, count: usize) -> Result<Self, GpuError> {
-        Self::build(ctx, tree, FkStrategy::AncestorWalk, count.max(1))
+        Self::build(ctx, tree, FkStrategy::for_tree(&tree.segments.parent), count.max(1))
     }
 
     fn build(ctx: &GpuContext, tree: &Tree, strategy: FkStrategy, instances: usize) -> Result<Self, GpuError> {
         let n = tree.segments.len();
+        // Level by level writes one instance. Pointer jumping takes a hierarchy's length from
+        // its ancestor lists, which storage bindings pad to 4 entries: under 4 segments (at
+        // most 3 levels) the walk is the same work.
+        let strategy = match strategy {
+            FkStrategy::LevelByLevel if instances > 1 => FkStrategy::AncestorWalk,
+            FkStrategy::PointerJump if n < 4 => FkStrategy::AncestorWalk,
+            s => s,
+        };
         let total = n * instances;
         let levels = match strategy {
             FkStrategy::AncestorWalk => Vec::new(),
             FkStrategy::LevelByLevel => {
                 upload_buckets(ctx, "fk level", &sylva_core::pose::fk::depth_buckets(&tree.segments.parent))?
             }
+            FkStrategy::PointerJump => Vec::new(),
+        };
+        let jumps = match strategy {
+            FkStrategy::PointerJump => sylva_core::pose::fk::jump_ancestors(&tree.segments.parent)
+                .iter()
+                .map(|anc| upload(ctx, "fk jump ancestors", anc))
+                .collect::<Result<_, _>>()?,
+            _ => Vec::new(),
         };
         let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
         Ok(Self {
             accumulate: Kernel::get(ctx, "pose_accumulate"),
             positions: Kernel::get(ctx, "pose_positions"),
             level: Kernel::get(ctx, "pose_level"),
+            jump: ["pose_jump_rotations", "pose_jump_terms", "pose_jump_sums", "pose_jump_joints"]
+                .map(|k| Kernel::get(ctx, k)),
             strategy,
             levels,
+            scratch: output::<[f32; 4]>(
+                ctx,
+                "fk scratch",
+                if strategy == FkStrategy::PointerJump { total } else { 1 },
+            )?,
+            jumps,
             disp: output::<[f32; 4]>(
                 ctx,
                 "fk displacements",
@@ -116,12 +174,17 @@ impl GpuPose {
         &self.delta
     }
 
+    /// The strategy this pose walks its hierarchy with.
+    pub fn strategy(&self) -> FkStrategy {
+        self.strategy
+    }
+
     /// Runs forward kinematics on the rotations in [`Self::delta_buffer`] (recorded into
     /// `encoder`).
     pub fn record(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+        let total = (self.n * self.instances) as u32;
         match self.strategy {
             FkStrategy::AncestorWalk => {
-                let total = (self.n * self.instances) as u32;
                 self.accumulate.record(ctx, encoder, &[&self.parents, &self.delta, &self.acc], total);
                 self.positions.record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, &self.joints], total);
             }
@@ -135,6 +198,20 @@ impl GpuPose {
                     );
                 }
             }
+            FkStrategy::PointerJump => {
+                // Rounds alternate between acc and scratch so that the last one writes acc.
+                let rounds = self.jumps.len();
+                if rounds == 0 {
+                    encoder.copy_buffer_to_buffer(&self.delta, 0, &self.acc, 0, self.acc.size());
+                }
+                let mut input = &self.delta;
+                for (k, anc) in self.jumps.iter().enumerate() {
+                    let out = if (rounds - 1 - k) % 2 == 0 { &self.acc } else { &self.scratch };
+                    self.jump[0].record(ctx, encoder, &[anc, input, out], total);
+                    input = out;
+                }
+                self.record_jump_positions(ctx, encoder);
+            }
         }
     }
 
@@ -142,8 +219,26 @@ impl GpuPose {
     /// [`Self::acc_buffer`] (methods whose rotations are already world rotations, as HSM's
     /// cluster R).
     pub fn record_positions(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+        match self.strategy {
+            FkStrategy::PointerJump => self.record_jump_positions(ctx, encoder),
+            _ => {
+                let total = (self.n * self.instances) as u32;
+                self.positions.record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, &self.joints], total);
+            }
+        }
+    }
+
+    /// Pointer jumping's joints from acc: the terms, the rounds of sums alternating between
+    /// joints and scratch so that the last one writes scratch, then rest + sum into joints.
+    fn record_jump_positions(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
         let total = (self.n * self.instances) as u32;
-        self.positions.record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, &self.joints], total);
+        let rounds = self.jumps.len();
+        let ping = |k: usize| if (rounds - k) % 2 == 0 { &self.scratch } else { &self.joints };
+        self.jump[1].record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, ping(0)], total);
+        for (k, anc) in self.jumps.iter().enumerate() {
+            self.jump[2].record(ctx, encoder, &[anc, ping(k), ping(k + 1)], total);
+        }
+        self.jump[3].record(ctx, encoder, &[&self.rest, &self.scratch, &self.joints], total);
     }
 
     /// The buffer of posed joint positions (w = 0), instance-major.
