@@ -14,6 +14,16 @@ pub fn atomic_png(
     size: (u32, u32),
     draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>) -> Result<()>,
 ) -> Result<()> {
+    pending_png(path, size, draw)?.commit().with_context(|| format!("writing {}", path.display()))
+}
+
+/// Draws into a temporary PNG beside `path` and returns it uncommitted, for outputs that
+/// appear together: commit each once all are drawn.
+pub fn pending_png(
+    path: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>) -> Result<()>,
+) -> Result<sylva_core::io::PendingFile> {
     let pending = sylva_core::io::PendingFile::new(path).with_context(|| format!("writing {}", path.display()))?;
     {
         let root = BitMapBackend::new(pending.tmp(), size).into_drawing_area();
@@ -21,7 +31,7 @@ pub fn atomic_png(
         draw(&root)?;
         root.present().with_context(|| format!("writing {}", path.display()))?;
     }
-    pending.commit().with_context(|| format!("writing {}", path.display()))
+    Ok(pending)
 }
 
 /// Registers [`FONT`] as plotters' `sans-serif`.

@@ -8,7 +8,8 @@ use anyhow::{Context, Result, bail};
 use glam::Vec3;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
-use sylva_bench::plot::atomic_png;
+use sylva_bench::plot::pending_png;
+use sylva_core::io::PendingFile;
 use sylva_core::wind::WindScene;
 use sylva_core::wind::sample::wind_sample;
 
@@ -81,16 +82,23 @@ pub fn run(args: &WindArgs) -> Result<[PathBuf; 2]> {
         bail!("--extent must be a positive number of metres, not {}", args.extent);
     }
     let scene = WindScene::resolve(&args.scene)?;
+    if args.backend == "gpu" {
+        // No adapter: say so before anything is created.
+        sylva_gpu::GpuContext::shared()?;
+    }
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("creating {}", args.out_dir.display()))?;
     sylva_bench::plot::register_font();
     let speed = args.out_dir.join("wind_speed.png");
     let field = args.out_dir.join("wind_field.png");
-    speed_plot(&scene, args, &speed)?;
-    field_map(&scene, args, &field)?;
+    // Both plots are drawn before either takes its name: the pair appears together.
+    let plots = [speed_plot(&scene, args, &speed)?, field_map(&scene, args, &field)?];
+    for (plot, path) in plots.into_iter().zip([&speed, &field]) {
+        plot.commit().with_context(|| format!("writing {}", path.display()))?;
+    }
     Ok([speed, field])
 }
 
-fn speed_plot(scene: &WindScene, a: &WindArgs, path: &Path) -> Result<()> {
+fn speed_plot(scene: &WindScene, a: &WindArgs, path: &Path) -> Result<PendingFile> {
     let n = 2000usize;
     let ts: Vec<f32> = (0..n).map(|i| a.from + (a.to - a.from) * i as f32 / (n - 1) as f32).collect();
     let samples: Vec<[f32; 4]> = ts.iter().map(|&t| [a.point.x, a.point.y, a.point.z, t]).collect();
@@ -98,7 +106,7 @@ fn speed_plot(scene: &WindScene, a: &WindArgs, path: &Path) -> Result<()> {
     let speed: Vec<f32> = v.iter().map(|v| Vec3::new(v[0], v[1], v[2]).length()).collect();
     let lo = v.iter().flat_map(|v| v[..3].iter().cloned()).fold(0.0f32, f32::min);
     let hi = speed.iter().cloned().fold(0.0f32, f32::max).max(0.1);
-    atomic_png(path, (1200, 600), |root| {
+    pending_png(path, (1200, 600), |root| {
         let mut chart = ChartBuilder::on(root)
             .caption(
                 format!("Wind at ({}, {}, {}) m — {}", a.point.x, a.point.y, a.point.z, a.scene),
@@ -134,7 +142,7 @@ fn speed_plot(scene: &WindScene, a: &WindArgs, path: &Path) -> Result<()> {
     })
 }
 
-fn field_map(scene: &WindScene, a: &WindArgs, path: &Path) -> Result<()> {
+fn field_map(scene: &WindScene, a: &WindArgs, path: &Path) -> Result<PendingFile> {
     let cells = 200usize;
     let e = a.extent;
     let at = |i: usize| -e + 2.0 * e * (i as f32 + 0.5) / cells as f32;
@@ -150,7 +158,7 @@ fn field_map(scene: &WindScene, a: &WindArgs, path: &Path) -> Result<()> {
         })
         .collect();
     let av = sample(scene, &a.backend, &arrow_samples)?;
-    atomic_png(path, (900, 900), |root| {
+    pending_png(path, (900, 900), |root| {
         let mut chart = ChartBuilder::on(root)
             .caption(
                 format!("Wind at t = {} s, height {} m (max {:.1} m/s) — {}", a.time, a.height, vmax, a.scene),

@@ -222,8 +222,8 @@ fn interrupted_render_leaves_no_partial_output_on_int_term_and_hup() {
 /// neither a temporary file nor an output under its final name.
 #[cfg(unix)]
 #[test]
-fn signals_stop_simulate_export_and_bench_with_no_file_left() {
-    let long: [(&str, &[&str]); 3] = [
+fn signals_stop_simulate_export_bench_and_wind_with_no_file_left() {
+    let long: [(&str, &[&str]); 4] = [
         (
             "simulate",
             &["simulate", "--species", "palm", "--method", "akagi", "--seconds", "100000", "--csv", "out/t.csv"],
@@ -233,10 +233,20 @@ fn signals_stop_simulate_export_and_bench_with_no_file_left() {
             &["export", "--species", "black_tupelo", "--method", "hsm", "--seconds", "20", "--out", "out/t.glb"],
         ),
         ("bench", &["bench", "song-t3", "--backend", "cpu", "--out-dir", "out"]),
+        // Four 4,096-component turbulence fields: ≈ 8 s of sampling on two cores.
+        ("wind", &["wind", "--scene", "heavy.toml", "--out-dir", "out"]),
     ];
+    let turbulence = |seed| {
+        format!(
+            "[[field]]\nkind = \"turbulence\"\nintensity = 1.2\nbeta = 1.67\nf_min = 0.01\nf_max = 5.0\n\
+             components = 4096\nmean_speed = 6.0\nvertical = 0.3\nseed = {seed}\n\n"
+        )
+    };
+    let heavy: String = (0..4).map(turbulence).collect();
     for (name, args) in long {
         for (signal, code) in SIGNALS {
             let dir = tempfile::tempdir().unwrap();
+            std::fs::write(dir.path().join("heavy.toml"), &heavy).unwrap();
             let out = dir.path().join("out");
             std::fs::create_dir(&out).unwrap();
             let child = spawn(dir.path(), args);
@@ -991,4 +1001,48 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
     let (ok, _, err) = sylva(dir.path(), &["fidelity", "--sizes", "0", "--out-dir", "g"]);
     assert!(!ok && err.contains("--sizes") && err.contains("size factor"), "{err}");
     assert!(!dir.path().join("g").exists());
+}
+
+/// Without a GPU driver (Vulkan's loader pointed at nothing, `WGPU_BACKEND=vulkan`), every
+/// command that needs the GPU says so, names the fix, exits 1 within 10 s and writes
+/// nothing: `simulate --backend gpu`, `render`, `wind --backend gpu`, `bench --backend gpu`
+/// and `view` (under Xvfb, so that the window opens and the adapter is what fails).
+#[test]
+fn without_a_gpu_driver_gpu_commands_fail_clearly_within_10_s_and_write_nothing() {
+    let x = Xvfb::start();
+    let commands: [&[&str]; 5] = [
+        &["simulate", "--species", "palm", "--backend", "gpu", "--seconds", "1", "--csv", "out/t.csv"],
+        &["render", "--out-dir", "out"],
+        &["wind", "--backend", "gpu", "--out-dir", "out/wind"],
+        &["bench", "zioma-t6-1", "--backend", "gpu", "--out-dir", "out"],
+        &["view"],
+    ];
+    for args in commands {
+        if args[0] == "view" && x.is_none() {
+            continue;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let mut command = Command::new(env!("CARGO_BIN_EXE_sylva"));
+        command
+            .current_dir(dir.path())
+            .args(args)
+            .env("VK_ICD_FILENAMES", "/nonexistent")
+            .env("WGPU_BACKEND", "vulkan")
+            .env_remove("RUST_BACKTRACE")
+            .env_remove("WAYLAND_DISPLAY");
+        if let Some(x) = &x {
+            command.env("DISPLAY", &x.display);
+        }
+        let start = std::time::Instant::now();
+        let out = command.output().unwrap();
+        let took = start.elapsed();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("no GPU adapter found") && err.contains("mesa-vulkan-drivers"), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(took.as_secs_f64() < 10.0, "{args:?} took {took:?}");
+        let left = entries(dir.path());
+        assert!(left.is_empty(), "{args:?} left {left:?}");
+        println!("{:<9} failed in {:.2} s: {}", args[0], took.as_secs_f64(), err.lines().next().unwrap_or(""));
+    }
 }
