@@ -234,49 +234,103 @@ pub const MAX_QUOTE: usize = 60;
 pub fn toml_error(text: &str, e: &toml::de::Error) -> (usize, usize, String) {
     let mut start = e.span().map_or(0, |s| s.start.min(text.len()));
     let mut message = shorten(e.message().trim());
-    // A tagged table (`[[field]]` with `kind = …`) is read whole before its fields, so a
-    // wrong type is reported at the table: find the first line in it holding a value of
-    // the type found.
+    // A tagged table (`[[field]]` with `kind = …`) is read whole before its fields, so an
+    // error in one of its values is reported at the table's header: find the value.
     if text[start..].starts_with('[')
-        && let Some(found) = message.strip_prefix("invalid type: ").and_then(|m| m.split(',').next())
+        && let Some(at) = locate_in_table(text, start, e.message())
     {
-        let looks = |v: &str| match found.split_whitespace().next().unwrap_or("") {
-            "map" => v.starts_with('{'),
-            "sequence" => v.starts_with('['),
-            "string" => v.starts_with('"') || v.starts_with('\''),
-            "boolean" => v == "true" || v == "false",
-            "integer" | "floating" => v.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+'),
-            _ => false,
-        };
-        // The span is the table's header: search the table, up to the next header.
-        let body = text[start..].find('\n').map_or(text.len(), |i| start + i + 1);
-        let end = text[body..].find("\n[").map_or(text.len(), |i| body + i + 1);
-        let mut offset = start;
-        for l in text[start..end].split_inclusive('\n') {
-            if let Some((_, v)) = l.split_once('=')
-                && looks(v.trim())
-            {
-                start = offset;
-                break;
-            }
-            offset += l.len();
-        }
+        start = at;
     }
     let (line, column) = line_col(text, start);
+    // An untagged enum says only what it wanted.
+    if let Some(wanted) = message.strip_prefix("wanted ") {
+        let value = text[start..].split(['\n', ',', '}']).next().unwrap_or("").trim();
+        message = format!("expected a {wanted}, found `{}`", cut(value));
+    }
     let quotes_a_key = message.contains("field `") || message.contains("key `");
-    if !quotes_a_key && (message.starts_with("duplicate key") || message.starts_with("invalid type")) {
-        // The key is what precedes `=` on the error's line (the span is the key or its value).
-        let line_text = text[..start].rsplit('\n').next().unwrap_or("");
-        let rest = text[start..].split('\n').next().unwrap_or("");
-        let whole = format!("{line_text}{rest}");
-        if let Some((key, _)) = whole.split_once('=') {
-            let key = key.trim().trim_start_matches('{').trim();
-            if !key.is_empty() && !key.starts_with('[') {
-                message = format!("{message} (key `{}`)", cut(key));
-            }
-        }
+    const NAMELESS: [&str; 6] =
+        ["duplicate key", "invalid type", "invalid value", "invalid length", "unknown variant", "expected a "];
+    if !quotes_a_key
+        && NAMELESS.iter().any(|m| message.starts_with(m))
+        && let Some(key) = key_at(text, start)
+    {
+        message = format!("{message} (key `{}`)", cut(&key));
     }
     (line, column, message)
+}
+
+/// The byte offset of the value a parse error `message` is about, in the table whose header
+/// starts at `header`: the value holding the token the message quotes (`-7`, `"a"`), or an
+/// array of the length it found, or the first value of the type it found.
+fn locate_in_table(text: &str, header: usize, message: &str) -> Option<usize> {
+    let body = text[header..].find('\n').map_or(text.len(), |i| header + i + 1);
+    let end = text[body..].find("\n[").map_or(text.len(), |i| body + i + 1);
+    // (offset of the value, value) for every `key = value` line of the table.
+    let mut values = Vec::new();
+    let mut offset = body;
+    for l in text[body..end].split_inclusive('\n') {
+        if let Some(eq) = l.find('=') {
+            let v = l[eq + 1..].split(" #").next().unwrap_or("").trim();
+            let lead = l[eq + 1..].len() - l[eq + 1..].trim_start().len();
+            values.push((offset + eq + 1 + lead, v));
+        }
+        offset += l.len();
+    }
+    let token = match (message.split('`').nth(1), message.split('"').nth(1)) {
+        (Some(t), _) => Some(t.to_string()),
+        (None, Some(t)) => Some(format!("\"{t}\"")),
+        _ => None,
+    };
+    let standalone = |v: &str, t: &str| {
+        v.match_indices(t).any(|(k, _)| {
+            let before = v[..k].chars().next_back();
+            let after = v[k + t.len()..].chars().next();
+            let edge = |c: Option<char>| c.is_none_or(|c| !(c.is_alphanumeric() || c == '.' || c == '_'));
+            edge(before) && edge(after)
+        })
+    };
+    if let Some(t) = &token
+        && let Some((at, _)) = values.iter().find(|(_, v)| standalone(v, t))
+    {
+        return Some(*at);
+    }
+    if let Some(n) = message.strip_prefix("invalid length ").and_then(|m| m.split(',').next()?.parse::<usize>().ok()) {
+        let len = |v: &str| {
+            v.strip_prefix('[')?.strip_suffix(']').map(|b| b.split(',').filter(|x| !x.trim().is_empty()).count())
+        };
+        if let Some((at, _)) = values.iter().find(|(_, v)| len(v) == Some(n)) {
+            return Some(*at);
+        }
+    }
+    let found = message.strip_prefix("invalid type: ")?.split(',').next()?;
+    let looks = |v: &str| match found.split_whitespace().next().unwrap_or("") {
+        "map" => v.starts_with('{'),
+        "sequence" => v.starts_with('['),
+        "string" => v.starts_with('"') || v.starts_with('\''),
+        "boolean" => v == "true" || v == "false",
+        "integer" | "floating" => v.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+'),
+        _ => false,
+    };
+    values.iter().find(|(_, v)| looks(v)).map(|(at, _)| *at)
+}
+
+/// The key whose value (or which itself) starts at byte `at`: the name before the nearest
+/// `=` before it on its line, or the name at `at` when it is the key.
+fn key_at(text: &str, at: usize) -> Option<String> {
+    let line_start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    let before = &text[line_start..at];
+    let is_key = |c: char| c.is_alphanumeric() || c == '_' || c == '-';
+    let key = match before.trim_end().strip_suffix('=') {
+        Some(k) => k.trim_end().rsplit(|c: char| !is_key(c)).next().unwrap_or(""),
+        // Inside a value (an array's element) or at the key itself.
+        None => match before.rfind('=') {
+            Some(eq) if !before[eq..].contains(['{', ',']) || before[eq..].contains('[') => {
+                before[..eq].trim_end().rsplit(|c: char| !is_key(c)).next().unwrap_or("")
+            }
+            _ => text[at..].split(|c: char| !is_key(c)).next().unwrap_or(""),
+        },
+    };
+    (!key.is_empty()).then(|| key.to_string())
 }
 
 /// `s` cut to [`MAX_QUOTE`] characters, saying how long it was.
@@ -288,18 +342,22 @@ pub fn cut(s: &str) -> String {
     format!("{}… ({n} characters)", s.chars().take(MAX_QUOTE).collect::<String>())
 }
 
-/// Cuts each backquoted token of a message and shortens digit runs longer than 17.
+/// Cuts each backquoted or double-quoted token of a message and shortens digit runs longer
+/// than 17.
 fn shorten(message: &str) -> String {
-    let mut out = String::new();
-    let mut parts = message.split('`');
-    if let Some(first) = parts.next() {
-        out.push_str(&digits(first));
-    }
-    for (k, part) in parts.enumerate() {
-        out.push('`');
-        out.push_str(&if k % 2 == 0 { cut(&digits(part)) } else { digits(part) });
-    }
-    out
+    let quoted = |message: &str, quote: char, inner: &dyn Fn(&str) -> String| {
+        let mut out = String::new();
+        let mut parts = message.split(quote);
+        if let Some(first) = parts.next() {
+            out.push_str(&inner(first));
+        }
+        for (k, part) in parts.enumerate() {
+            out.push(quote);
+            out.push_str(&if k % 2 == 0 { cut(&digits(part)) } else { inner(part) });
+        }
+        out
+    };
+    quoted(message, '`', &|outside: &str| quoted(outside, '"', &digits))
 }
 
 /// Digit runs longer than 17 (an f64 written out in full) as `d.ddde±N`.
@@ -348,6 +406,30 @@ pub fn nested_field_line(text: &str, field: &str) -> usize {
     }
 }
 
+/// A fixed-size array read from TOML keeps its first elements and drops the rest without a
+/// word: compares the text's arrays with the value read (`parsed`, serialised back) and
+/// names the first whose length was not kept: (dotted path as [`field_line`] reads it,
+/// length written, length read).
+pub fn dropped_elements<T: serde::Serialize>(text: &str, parsed: &T) -> Option<(String, usize, usize)> {
+    fn walk(raw: &toml::Table, read: &toml::Table, prefix: &str) -> Option<(String, usize, usize)> {
+        raw.iter().find_map(|(key, v)| {
+            let path = if prefix.is_empty() { key.clone() } else { format!("{prefix}.{key}") };
+            match (v, read.get(key)?) {
+                (toml::Value::Table(a), toml::Value::Table(b)) => walk(a, b, &path),
+                (toml::Value::Array(a), toml::Value::Array(b)) if a.len() != b.len() => Some((path, a.len(), b.len())),
+                (toml::Value::Array(a), toml::Value::Array(b)) => a
+                    .iter()
+                    .zip(b)
+                    .enumerate()
+                    .find_map(|(i, (x, y))| walk(x.as_table()?, y.as_table()?, &format!("{path}[{i}]"))),
+                _ => None,
+            }
+        })
+    }
+    let raw = toml::from_str::<toml::Table>(text).ok()?;
+    walk(&raw, &toml::Table::try_from(parsed).ok()?, "")
+}
+
 /// 1-based line and column of a byte offset.
 pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
@@ -360,9 +442,72 @@ pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
 /// table (`level[1].length`), `name.key` in `[name]` (`wood.density`, `output.fps`), `key` at
 /// the top. The line of the table when the key is absent; 1 when nothing matches (best
 /// effort, for error messages).
+///
+/// A key that indexes an array of inline tables (`tree[0].copies[2].scale`,
+/// `field[1].waves[0].speed`) finds that element's key, or the element.
 pub fn field_line(text: &str, field: &str) -> usize {
     let (found, table_line) = find_field(text, field);
-    found.unwrap_or(table_line)
+    match found {
+        Some(line) => element_line(text, line, field).unwrap_or(line),
+        None => table_line,
+    }
+}
+
+/// For a path whose key is `name[k].sub`, set on 1-based `line` as `name = [ {…}, … ]`: the
+/// line of `sub` inside the k-th inline table, or of that table.
+fn element_line(text: &str, line: usize, field: &str) -> Option<usize> {
+    let key = field.split_once('.').map_or(field, |(t, k)| if t.contains('[') { k } else { field });
+    let (name, rest) = key.split_once('[')?;
+    let (index, sub) = rest.split_once(']')?;
+    let index: usize = index.parse().ok()?;
+    let sub = sub.strip_prefix('.').unwrap_or(sub);
+    let start = text.split_inclusive('\n').take(line - 1).map(str::len).sum::<usize>();
+    let open = start + text[start..].find(name)? + name.len();
+    let open = open + text[open..].find('[')? + 1;
+    // Walk the array: depth 1 is its elements; a `{` at depth 1 opens one.
+    let (mut depth, mut seen, mut in_string) = (1usize, 0usize, false);
+    let mut element = None;
+    for (i, ch) in text[open..].char_indices() {
+        let at = open + i;
+        match ch {
+            '"' => in_string = !in_string,
+            _ if in_string => {}
+            '#' => {}
+            '[' | '{' => {
+                if ch == '{' && depth == 1 {
+                    if seen == index {
+                        element = Some(at);
+                    }
+                    seen += 1;
+                }
+                depth += 1;
+            }
+            ']' | '}' => {
+                depth -= 1;
+                if depth == 1
+                    && let Some(element) = element
+                {
+                    let body = &text[element..at];
+                    let found = (!sub.is_empty())
+                        .then(|| {
+                            body.match_indices(sub).find(|(k, _)| {
+                                let before = body[..*k].chars().next_back();
+                                let after = body[k + sub.len()..].trim_start();
+                                before.is_none_or(|c| !(c.is_alphanumeric() || c == '_')) && after.starts_with('=')
+                            })
+                        })
+                        .flatten()
+                        .map_or(element, |(k, _)| element + k);
+                    return Some(line_col(text, found).0);
+                }
+                if depth == 0 {
+                    return None;
+                }
+            }
+            _ => {}
+        }
+    }
+    None
 }
 
 /// The line where `field` is set (`None` when absent) and the line of its table.

@@ -383,6 +383,15 @@ impl Scene {
         scene.base_dir = base_dir.to_path_buf();
         scene.file = file.to_string();
         scene.source = SourceText(text.into());
+        if let Some((field, written, read)) = crate::io::dropped_elements(text, &scene) {
+            return Err(SceneError::Value {
+                file: file.to_string(),
+                line: field_line(text, &field),
+                field,
+                value: format!("{written} elements"),
+                expected: format!("{read} elements"),
+            });
+        }
         scene.check().map_err(|(field, value, expected)| SceneError::Value {
             file: file.to_string(),
             line: field_line(text, &field),
@@ -469,13 +478,22 @@ impl Scene {
             return err("camera.fov_deg", c.fov_deg.to_string(), "1 to 170 degrees");
         }
         let (eye, target) = (glam::Vec3::from_array(c.eye), glam::Vec3::from_array(c.target));
-        if !eye.is_finite() || !target.is_finite() || (eye - target).length() < 1e-3 {
-            return err("camera.eye", format!("{:?}", c.eye), "finite and away from the target");
+        if !eye.is_finite() {
+            return err("camera.eye", format!("{:?}", c.eye), "finite coordinates");
+        }
+        if !target.is_finite() {
+            return err("camera.target", format!("{:?}", c.target), "finite coordinates");
+        }
+        if (eye - target).length() < 1e-3 {
+            return err("camera.target", format!("{:?}", c.target), "a point away from the eye");
         }
         if !glam::Vec3::from_array(self.sun.direction).is_finite()
             || glam::Vec3::from_array(self.sun.direction).length() < 1e-6
         {
             return err("sun.direction", format!("{:?}", self.sun.direction), "a non-zero direction");
+        }
+        if !(self.sun.intensity.is_finite() && (0.0..=100.0).contains(&self.sun.intensity)) {
+            return err("sun.intensity", self.sun.intensity.to_string(), "0 to 100");
         }
         if self.trees.is_empty() {
             return err("tree", "none".into(), "at least one [[tree]]");
@@ -503,6 +521,9 @@ impl Scene {
             if !glam::Vec3::from_array(t.position).is_finite() {
                 return err(&f("position"), format!("{:?}", t.position), "finite coordinates");
             }
+            if !(t.yaw_deg.is_finite() && t.yaw_deg.abs() <= 1e4) {
+                return err(&f("yaw_deg"), t.yaw_deg.to_string(), "-10000 to 10000 degrees");
+            }
             if !(t.scale.is_finite() && t.scale > 0.0 && t.scale <= 100.0) {
                 return err(&f("scale"), t.scale.to_string(), "a scale in (0, 100]");
             }
@@ -521,9 +542,16 @@ impl Scene {
             if !(1..=MAX_PHASE_GROUPS).contains(&t.phase_groups) {
                 return err(&f("phase_groups"), t.phase_groups.to_string(), "1 to 16 simulations");
             }
-            for c in &t.copies {
-                if !(glam::Vec3::from_array(c.position).is_finite() && c.scale.is_finite() && c.scale > 0.0) {
-                    return err(&f("copies"), format!("{:?}", c.position), "finite positions and positive scales");
+            for (k, c) in t.copies.iter().enumerate() {
+                let f = |key: &str| format!("tree[{i}].copies[{k}].{key}");
+                if !glam::Vec3::from_array(c.position).is_finite() {
+                    return err(&f("position"), format!("{:?}", c.position), "finite coordinates");
+                }
+                if !(c.yaw_deg.is_finite() && c.yaw_deg.abs() <= 1e4) {
+                    return err(&f("yaw_deg"), c.yaw_deg.to_string(), "-10000 to 10000 degrees");
+                }
+                if !(c.scale.is_finite() && c.scale > 0.0 && c.scale <= 100.0) {
+                    return err(&f("scale"), c.scale.to_string(), "a scale in (0, 100]");
                 }
             }
         }

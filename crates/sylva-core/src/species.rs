@@ -114,6 +114,14 @@ impl SpeciesSource {
             let (line, column, message) = crate::io::toml_error(text, &e);
             SpeciesError::Toml { file: file.to_string(), line, column, message }
         })?;
+        if let Some((field, written, read)) = crate::io::dropped_elements(text, &params) {
+            return Err(SpeciesError::Field {
+                file: file.to_string(),
+                line: field_line(text, &field),
+                field,
+                message: format!("{written} elements, expected {read}"),
+            });
+        }
         params.check().map_err(|e| SpeciesError::Field {
             file: file.to_string(),
             line: field_line(text, &e.field),
