@@ -449,6 +449,11 @@ pub fn field_line(text: &str, field: &str) -> usize {
     let (found, table_line) = find_field(text, field);
     match found {
         Some(line) => element_line(text, line, field).unwrap_or(line),
+        // A whole table (`level` of `[[level]]` tables): its first header.
+        None if !field.contains(['.', '[']) => text
+            .lines()
+            .position(|l| [format!("[[{field}]]"), format!("[{field}]")].iter().any(|h| l.trim_start().starts_with(h)))
+            .map_or(table_line, |i| i + 1),
         None => table_line,
     }
 }

@@ -147,3 +147,55 @@ fn wind_range_errors_name_the_line() {
     let e = sylva_core::wind::WindScene::from_toml(wind, "w.toml").unwrap_err().to_string();
     assert!(e.starts_with("w.toml:4: field[0].speed") && e.contains("outside"), "{e}");
 }
+
+/// Degenerate trees the hardening report asked about: one segment and no leaf (`axiom: F`),
+/// a Weber–Penn trunk with no branch level and no leaf (`levels = 1`, `leaves = 0`), and a
+/// grammar whose branches skip a level (a level-2 stem straight on the trunk is impossible
+/// in a grammar, so levels 0 and 1 with leaves only on the trunk). Every method steps them
+/// through 2 s of gusty wind: the pose stays finite and the tip moves.
+#[test]
+fn degenerate_trees_simulate_in_every_method() {
+    use std::sync::Arc;
+    use sylva_core::methods::{MethodOptions, akagi, hsm, skjermo, zioma};
+    let one =
+        SpeciesSource::from_text("name: one\naxiom: F\n", "one.lsys").unwrap().generate(1, &Limits::default(), None);
+    let palm =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../presets/species/palm.toml")).unwrap();
+    // Too many [[level]] tables for `levels = 1` are refused at the first of them.
+    let e = SpeciesSource::from_text(&palm.replace("levels = 2", "levels = 1"), "trunk.toml").unwrap_err().to_string();
+    let first = palm.lines().position(|l| l.starts_with("[[level]]")).unwrap() + 1;
+    assert!(e.starts_with(&format!("trunk.toml:{first}:")) && e.contains("3 [[level]] tables"), "{e}");
+    // The trunk's [[level]] table and the one placing leaves: the third is dropped.
+    let third = palm.match_indices("[[level]]").nth(2).unwrap().0;
+    let text = palm[..third].replace("levels = 2", "levels = 1").replace("leaves = ", "leaves = 0 #");
+    let trunk = SpeciesSource::from_text(&text, "trunk.toml").unwrap().generate(1, &Limits::default(), None);
+    let leaf_on_trunk =
+        SpeciesSource::from_text("name: l\naxiom: F[+F]FL\n", "l.lsys").unwrap().generate(1, &Limits::default(), None);
+    let wind = Arc::new(sylva_core::wind::WindScene::resolve("gusty").unwrap().packed());
+    for (name, tree) in [("one segment", one), ("trunk only", trunk), ("leaf on the trunk", leaf_on_trunk)] {
+        let tree = Arc::new(tree.unwrap_or_else(|e| panic!("{name}: {e}")));
+        assert!(!tree.segments.is_empty(), "{name}");
+        let options = MethodOptions::seeded(1);
+        for mut animator in [
+            zioma::animator(tree.clone(), &options).unwrap(),
+            akagi::animator(tree.clone(), &options).unwrap(),
+            skjermo::animator(tree.clone(), &options).unwrap(),
+            hsm::animator(tree.clone(), &options).unwrap(),
+        ] {
+            animator.set_wind(wind.clone());
+            let rest = animator.pose();
+            animator.advance(1.0 / 60.0, 120);
+            let pose = animator.pose();
+            let method = animator.name();
+            assert!(pose.start.iter().all(|p| p.is_finite()), "{name}, {method}: finite joints");
+            assert!(pose.orientation.iter().all(|q| q.is_finite()), "{name}, {method}: finite rotations");
+            // The last segment's direction (chord ≈ angle; acos cannot resolve 1e-5 rad in f32)
+            // or its joint: a bare trunk barely moves, but it moves.
+            let n = tree.segments.len() - 1;
+            let turned = (pose.orientation[n] * glam::Vec3::Y - rest.orientation[n] * glam::Vec3::Y).length();
+            let shift = (pose.start[n] - rest.start[n]).length();
+            println!("{name}, {method}: {} segments, tip turned {turned:.2e} rad, moved {shift:.2e} m", n + 1);
+            assert!(turned > 1e-6 || shift > 1e-6, "{name}, {method}: the tip stayed still in 2 s of gusty wind");
+        }
+    }
+}
