@@ -179,9 +179,14 @@ fn generate(args: GenerateArgs) -> Result<()> {
         Some(p) if p.as_os_str() == "-" => None,
         Some(p) => Some(p.clone()),
         None => {
-            let stem = std::path::Path::new(&args.species)
-                .file_stem()
-                .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
+            // A preset by any of its names writes under its name (`Quaking Aspen` →
+            // `quaking_aspen.obj`); a file under its stem.
+            let stem = match sylva_core::species::Preset::find(&args.species) {
+                Some(p) => p.name.to_string(),
+                None => std::path::Path::new(&args.species)
+                    .file_stem()
+                    .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned()),
+            };
             Some(PathBuf::from("out").join(format!("{stem}.obj")))
         }
     };

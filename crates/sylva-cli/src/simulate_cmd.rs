@@ -1,6 +1,7 @@
 //! `sylva simulate`: run an animation method and report how the tree moved.
 
 use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
@@ -70,12 +71,6 @@ impl TreeWindArgs {
     /// The method's options: the seed and the `--param`s.
     pub fn options(&self) -> MethodOptions {
         MethodOptions { seed: self.seed, params: self.params.iter().cloned().collect() }
-    }
-
-    /// The method's name with a capital (for reports).
-    pub fn method_title(&self) -> String {
-        let mut c = self.method.chars();
-        c.next().map_or(String::new(), |f| f.to_uppercase().chain(c).collect())
     }
 }
 
@@ -242,11 +237,11 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         println!("wrote {} ({} tracked segments × {frames} frames)", path.display(), track.len());
     }
     println!(
-        "{} (seed {}), {} on {:?}, wind `{}`: {} frames over {} s in {:.2} s ({:.2} ms per frame)",
+        "{} (seed {}), {} on the {}, wind `{}`: {} frames over {} s in {:.2} s ({:.2} ms per frame)",
         tree.name,
         tree.seed,
-        a.tree.method_title(),
-        a.backend,
+        a.tree.method,
+        a.backend.to_possible_value().map_or_else(String::new, |v| v.get_name().to_uppercase()),
         a.tree.wind,
         frames,
         a.seconds,

@@ -539,19 +539,19 @@ fn simulate_runs_akagi_too() {
         &["simulate", "--method", "akagi", "--species", "monopodial", "--seconds", "1", "--fps", "30"],
     );
     assert!(ok, "{err}");
-    assert!(out.contains("Akagi on Cpu") && out.contains("31 frames"), "{out}");
+    assert!(out.contains("akagi on the CPU") && out.contains("31 frames"), "{out}");
     let (ok, out, err) = sylva(
         dir.path(),
         &["simulate", "--method", "skjermo", "--species", "monopodial", "--seconds", "1", "--fps", "30"],
     );
     assert!(ok, "{err}");
-    assert!(out.contains("Skjermo on Cpu"), "{out}");
+    assert!(out.contains("skjermo on the CPU"), "{out}");
     let (ok, out, err) = sylva(
         dir.path(),
         &["simulate", "--method", "hsm", "--species", "stochastic_bush", "--seconds", "1", "--fps", "30"],
     );
     assert!(ok, "{err}");
-    assert!(out.contains("Hsm on Cpu") && out.contains("clusters") && !out.contains("speed 0.000"), "{out}");
+    assert!(out.contains("hsm on the CPU") && out.contains("clusters") && !out.contains("speed 0.000"), "{out}");
     let (ok, _, err) = sylva(dir.path(), &["simulate", "--method", "akagi", "--trunk-only"]);
     assert!(!ok && err.contains("--trunk-only"), "{err}");
 }
@@ -584,7 +584,7 @@ fn simulate_runs_hsm_on_the_gpu() {
     let args = ["simulate", "--method", "hsm", "--species", "stochastic_bush", "--seconds", "0.5", "--fps", "30"];
     let (ok, out, err) = sylva(dir.path(), &[&args[..], &["--backend", "gpu"]].concat());
     assert!(ok, "{err}");
-    assert!(out.contains("Hsm on Gpu") && out.contains("16 frames") && !out.contains("speed 0.000"), "{out}");
+    assert!(out.contains("hsm on the GPU") && out.contains("16 frames") && !out.contains("speed 0.000"), "{out}");
 }
 
 #[test]
@@ -1045,4 +1045,43 @@ fn without_a_gpu_driver_gpu_commands_fail_clearly_within_10_s_and_write_nothing(
         assert!(left.is_empty(), "{args:?} left {left:?}");
         println!("{:<9} failed in {:.2} s: {}", args[0], took.as_secs_f64(), err.lines().next().unwrap_or(""));
     }
+}
+
+/// The rough edges a new user met: a preset by its display name, with hyphens or in any
+/// case; the README's preset path from outside the repository; a missing file said to be
+/// missing where it was looked for; the method and backend as typed, not Rust's names; a
+/// limit's hint naming a flag that exists, once.
+#[test]
+fn species_names_paths_and_output_read_as_a_user_writes_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let digest = |out: &str| out.lines().find(|l| l.trim_start().starts_with("digest")).map(str::to_string);
+    let (ok, reference, err) = sylva(dir.path(), &["generate", "--species", "quaking_aspen", "--out", "-"]);
+    assert!(ok, "{err}");
+    for name in ["quaking-aspen", "Quaking_Aspen", "Quaking Aspen", "QUAKING ASPEN"] {
+        let (ok, out, err) = sylva(dir.path(), &["generate", "--species", name]);
+        assert!(ok, "{name}: {err}");
+        assert_eq!(digest(&out), digest(&reference), "{name}: the same tree as quaking_aspen");
+        assert!(out.contains("wrote out/quaking_aspen.obj"), "{name}: written under the preset's name: {out}");
+    }
+    // The README's path, from a directory with no `presets/` in it.
+    let (ok, out, err) = sylva(dir.path(), &["generate", "--species", "presets/grammars/ternary.lsys", "--out", "-"]);
+    assert!(ok, "{err}");
+    let (_, shipped, _) = sylva(dir.path(), &["generate", "--species", "ternary", "--out", "-"]);
+    assert_eq!(digest(&out), digest(&shipped));
+    let (ok, _, err) = sylva(dir.path(), &["generate", "--species", "nowhere/mine.lsys"]);
+    let cwd = dir.path().canonicalize().unwrap();
+    assert!(!ok && err.contains("no such file relative to") && err.contains(cwd.to_str().unwrap()), "{err}");
+    // Names as typed.
+    let (ok, out, err) = sylva(
+        dir.path(),
+        &["simulate", "--species", "palm", "--method", "akagi", "--backend", "cpu", "--seconds", "0.2"],
+    );
+    assert!(ok, "{err}");
+    assert!(out.contains("akagi on the CPU") && !out.contains("Cpu") && !out.contains("Akagi on"), "{out}");
+    // A limit's hint: a flag that exists, said once.
+    let (ok, _, err) = sylva(dir.path(), &["generate", "--species", "ternary", "--iterations", "100000"]);
+    assert!(!ok && err.matches("--max-iterations").count() == 1, "{err}");
+    let (ok, _, err) =
+        sylva(dir.path(), &["generate", "--species", "ternary", "--iterations", "3", "--max-iterations", "100000"]);
+    assert!(ok, "the flag the hint names exists: {err}");
 }

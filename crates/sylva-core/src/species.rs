@@ -69,6 +69,28 @@ pub const PRESETS: &[Preset] = &[
     grammar!("stochastic_bush"),
 ];
 
+impl Preset {
+    /// The preset a name means: its name or its display name (`name` in the file), in any
+    /// case, with spaces, hyphens or underscores (`quaking-aspen`, `Quaking Aspen`).
+    pub fn find(arg: &str) -> Option<&'static Preset> {
+        let key = |s: &str| s.trim().to_lowercase().replace([' ', '-'], "_");
+        let wanted = key(arg);
+        PRESETS.iter().find(|p| key(p.name) == wanted || key(p.display_name()) == wanted)
+    }
+
+    /// The display name written in the file (`name = "Quaking Aspen"` or `name: …`).
+    pub fn display_name(&self) -> &'static str {
+        self.text
+            .lines()
+            .find_map(|l| {
+                let rest = l.trim_start().strip_prefix("name")?.trim_start();
+                let value = rest.strip_prefix('=').or_else(|| rest.strip_prefix(':'))?.trim();
+                Some(value.trim_matches('"'))
+            })
+            .unwrap_or(self.name)
+    }
+}
+
 /// The species used when none is named.
 pub const DEFAULT_SPECIES: &str = "quaking_aspen";
 
@@ -76,8 +98,15 @@ pub const DEFAULT_SPECIES: &str = "quaking_aspen";
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SpeciesError {
     /// Neither a preset nor an existing file.
-    #[error("no preset or file named `{name}`; presets: {available}")]
-    NotFound { name: String, available: String },
+    #[error("no preset or file named `{name}`{looked}; presets: {available}")]
+    NotFound {
+        /// What was asked for.
+        name: String,
+        /// Where a path was looked for (` (looked for …)`), empty for a plain name.
+        looked: String,
+        /// The presets' names.
+        available: String,
+    },
     /// The file could not be read.
     #[error("{file}: {message}")]
     Io { file: String, message: String },
@@ -139,7 +168,7 @@ impl SpeciesSource {
     /// Resolves a preset name or a file path, parsing a grammar within `limits` (its
     /// `iterations` and expression depth).
     pub fn resolve_with(arg: &str, limits: &Limits) -> Result<Self, SpeciesError> {
-        if let Some(p) = PRESETS.iter().find(|p| p.name == arg) {
+        if let Some(p) = Preset::find(arg) {
             return Self::from_preset(p);
         }
         let path = Path::new(arg);
@@ -150,8 +179,25 @@ impl SpeciesSource {
             }
             return Self::from_text(&text, arg);
         }
+        // A shipped preset's path written from elsewhere (`presets/grammars/ternary.lsys`
+        // outside the repository) is that preset.
+        if let Some(p) = PRESETS.iter().find(|p| arg.ends_with(p.file)) {
+            return Self::from_preset(p);
+        }
+        let looked = if arg.contains(['/', '\\']) || arg.ends_with(".toml") || arg.ends_with(".lsys") {
+            let cwd =
+                std::env::current_dir().map_or_else(|_| "the working directory".into(), |d| d.display().to_string());
+            if path.is_absolute() {
+                " (no such file)".to_string()
+            } else {
+                format!(" (no such file relative to {cwd})")
+            }
+        } else {
+            String::new()
+        };
         Err(SpeciesError::NotFound {
             name: arg.to_string(),
+            looked,
             available: PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", "),
         })
     }

@@ -128,3 +128,22 @@ fn mass_and_stiffness_follow_the_formulas() {
     let twig = s.stiffness[s.len() - 1];
     assert!(trunk > 1e3 * twig);
 }
+
+/// Every preset is found by its name and by its display name, in any case, with spaces,
+/// hyphens or underscores; other names find nothing.
+#[test]
+fn presets_are_found_by_name_and_display_name() {
+    use sylva_core::species::Preset;
+    for p in PRESETS {
+        let display = p.display_name();
+        assert_ne!(display, "", "{}", p.name);
+        for name in [p.name.to_string(), p.name.replace('_', "-"), p.name.to_uppercase(), display.to_string()] {
+            assert_eq!(Preset::find(&name).map(|f| f.name), Some(p.name), "`{name}`");
+        }
+        assert_eq!(Preset::find(&display.replace(' ', "-").to_lowercase()).map(|f| f.name), Some(p.name), "{display}");
+    }
+    assert_eq!(PRESETS.iter().find(|p| p.name == "quaking_aspen").unwrap().display_name(), "Quaking Aspen");
+    for other in ["", "aspen", "quaking__aspen", "quaking_aspen.toml"] {
+        assert!(Preset::find(other).is_none(), "`{other}`");
+    }
+}
