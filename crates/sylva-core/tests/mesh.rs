@@ -4,7 +4,9 @@
 use glam::{Quat, Vec3};
 use rand::{Rng, SeedableRng};
 use sylva_core::Tree;
-use sylva_core::mesh::{MeshError, MeshFrame, MeshLayout, MeshParams, RawVertex};
+use sylva_core::mesh::{
+    DeformLayout, DeformerParams, MeshError, MeshFrame, MeshLayout, MeshParams, RawVertex, deform_radius,
+};
 use sylva_core::methods::Method;
 use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, SpeciesSource};
@@ -288,7 +290,8 @@ mod deformer {
     fn branches_follow_their_current_bezier() {
         let t = tree("black_tupelo");
         let h = t.height();
-        let p = DeformerParams { trunk_lobe_depth: 0.0, ..Default::default() };
+        let p = DeformerParams { trunk_lobe_depth: 0.0, ..DeformerParams::for_tree(&t) };
+        assert!(p.trunk_flare > 0.0, "the tupelo's flare is exercised");
         let layout = DeformLayout::new(&t, p).unwrap();
         let m = Skjermo::new(&t, SkjermoParams::default());
         let mut state = m.rest_state(&t);
@@ -342,6 +345,8 @@ mod deformer {
         let p = DeformerParams {
             sides: 64,
             rows_per_segment: 16,
+            trunk_flare: 0.6,
+            trunk_lobes: 5.0,
             trunk_lobe_depth: 0.1,
             bulges: 3.0,
             bulge_depth: 0.05,
@@ -443,4 +448,57 @@ fn subdivided_bands_are_crack_free_and_displaced_by_the_relief_at_their_midpoint
     }
     assert!(displaced > 0 && on_boundary > 0, "{displaced} displaced, {on_boundary} on boundaries");
     assert!(largest > 0.2, "the relief between rings adds detail ({largest} of the amplitude at most)");
+}
+
+/// Skjermo's deformer flares the trunk once, as the species says: the aspen's deformed base
+/// radius (at θ = 0, where its lobes add nothing) over its unflared radius is within 2 % of
+/// Weber–Penn's flare at the base, `1 + 0.99 flare`, so it matches the segments' own base
+/// radius; the flare is gone by an eighth of the way up.
+#[test]
+fn the_deformer_flares_the_trunk_once_as_weber_penn_does() {
+    let t = tree("quaking_aspen");
+    let flare = t.trunk_shape.flare;
+    assert!((flare - 0.6).abs() < 1e-6, "the aspen's Weber–Penn flare");
+    let layout = DeformLayout::new(&t, DeformerParams::for_tree(&t)).unwrap();
+    let s = &layout.shapes[0];
+    let unflared = t.segments.radius_base[0] / t.trunk_shape.flare_factor(0.0);
+    assert!((s.radius - unflared).abs() <= 1e-6 * unflared, "the grid's radius is the unflared one");
+    let (base, _, _) = deform_radius(s, 0.0, 0.0);
+    let taper_at = |v: f32| s.radius * (1.0 - v.powf(s.taper));
+    let ratio = base / s.radius;
+    let weber_penn = 1.0 + flare * 0.99;
+    assert!((ratio / weber_penn - 1.0).abs() < 0.02, "deformed / rest base radius {ratio}, Weber–Penn {weber_penn}");
+    assert!((base / t.segments.radius_base[0] - 1.0).abs() < 0.02, "matches the segments' base radius");
+    let (eighth, _, _) = deform_radius(s, 0.125, 0.0);
+    assert!((eighth / taper_at(0.125) - 1.0).abs() < 0.01, "flare {} left at an eighth", eighth / taper_at(0.125));
+    // Trees without flare (grammars) keep their radius at the base.
+    let g = tree("sympodial");
+    assert_eq!(g.trunk_shape, Default::default());
+    let layout = DeformLayout::new(&g, DeformerParams::for_tree(&g)).unwrap();
+    let (r, _, _) = deform_radius(&layout.shapes[0], 0.0, 0.0);
+    assert!((r / g.segments.radius_base[0] - 1.0).abs() < 1e-6, "no flare asked, none added");
+}
+
+/// The trunk's cross-section follows the species: round where `lobes = 0` (palm, fir), with
+/// the species' lobes and depth elsewhere (the aspen's 5 at 0.07).
+#[test]
+fn trunk_lobes_come_from_the_species() {
+    for p in sylva_core::species::PRESETS.iter().filter(|p| p.kind == sylva_core::species::PresetKind::Species) {
+        let t = tree(p.name);
+        let layout = DeformLayout::new(&t, DeformerParams::for_tree(&t)).unwrap();
+        let s = &layout.shapes[0];
+        let radii: Vec<f32> =
+            (0..64).map(|k| deform_radius(s, 0.05, k as f32 * std::f32::consts::TAU / 64.0).0).collect();
+        let (lo, hi) = radii.iter().fold((f32::MAX, 0.0f32), |(a, b), &r| (a.min(r), b.max(r)));
+        let spread = (hi - lo) / (hi + lo);
+        let (lobes, depth) = (t.trunk_shape.lobes, t.trunk_shape.lobe_depth);
+        if lobes == 0 || depth == 0.0 {
+            assert!(spread < 1e-6, "{}: lobes 0, yet the section varies by {spread}", p.name);
+        } else {
+            // 1 ± depth (1 − 0.05 fade) around the ring.
+            let want = depth * 0.95;
+            assert!((spread - want).abs() < 0.1 * want + 1e-3, "{}: spread {spread}, want {want}", p.name);
+            assert_eq!(s.lobes, lobes as f32, "{}", p.name);
+        }
+    }
 }

@@ -147,7 +147,7 @@ fn gpu_deformer_matches_cpu_on_every_preset() {
             rows_per_segment: rng.random_range(1..4),
             bulges: rng.random_range(0.0..4.0),
             bulge_depth: rng.random_range(0.0..0.1),
-            ..Default::default()
+            ..DeformerParams::for_tree(&t)
         };
         let layout = DeformLayout::new(&t, params).unwrap();
         let m = Skjermo::new(&t, SkjermoParams::default());

@@ -401,7 +401,10 @@ impl WorldTree {
                 let lead_s = lead_steps as f32 * dt;
                 let sim = build_sim(&wind.clock(ctx, lead_s)?, &[])?;
                 let deform = if sim.has_curves() {
-                    let grid = DeformLayout::new(&tree, DeformerParams { sides: params.sides, ..Default::default() })?;
+                    let grid = DeformLayout::new(
+                        &tree,
+                        DeformerParams { sides: params.sides, ..DeformerParams::for_tree(&tree) },
+                    )?;
                     bark_triangles = grid.triangle_count();
                     Some(match &sim {
                         Simulation::Cpu(a) => GpuDeform::new(ctx, &grid, a.curves().expect("has curves").stems)?,

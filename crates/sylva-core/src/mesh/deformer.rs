@@ -63,7 +63,9 @@ pub struct RawDeformRing {
     pub _pad: u32,
 }
 
-/// Deformer parameters.
+/// Deformer parameters. The trunk's shape comes from the species ([`Self::for_tree`]:
+/// Weber–Penn `Flare`, `Lobes`, `LobeDepth`, and the species' bulges); the defaults give a
+/// round, unflared trunk.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DeformerParams {
     /// Sides around each stem. Default 8, as the tubes.
@@ -71,17 +73,19 @@ pub struct DeformerParams {
     /// Cross-sections per stem segment (the grid's rows follow the stem's resolution).
     /// Default 2: one Bézier per stem needs fewer rows than the Hermite chain.
     pub rows_per_segment: u32,
-    /// Flare of trunks (eq. 3). Default 0.6, Weber–Penn's Quaking Aspen. Branches: 0.
+    /// Flare of trunks (eq. 3), applied to the unflared base radius. Default 0; the species'
+    /// `flare` with [`Self::for_tree`]. Branches: 0.
     pub trunk_flare: f32,
-    /// Lobes of trunks (eq. 5). Default 5; branches: none.
+    /// Lobes of trunks (eq. 5). Default 0; the species' `lobes`. Branches: none.
     pub trunk_lobes: f32,
-    /// Lobe depth of trunks. Default 0.07 (Weber–Penn's `lobe_depth` for oaks and aspens).
+    /// Lobe depth of trunks, 0 to 0.9. Default 0; the species' `lobe_depth`.
     pub trunk_lobe_depth: f32,
-    /// Lobe fade. Default 1: lobes vanish toward the tip.
+    /// Lobe fade (eq. 5, `l_t`). Default 1: lobes vanish toward the tip, as Skjermo's roots
+    /// spread at the base (Weber–Penn keeps them all the way up).
     pub lobe_fade: f32,
-    /// Bulges per stem (eq. 4). Default 0.
+    /// Bulges per stem (eq. 4). Default 0; the species' `bulges`.
     pub bulges: f32,
-    /// Bulge depth. Default 0.
+    /// Bulge depth, 0 to 0.9. Default 0; the species' `bulge_depth`.
     pub bulge_depth: f32,
 }
 
@@ -90,12 +94,27 @@ impl Default for DeformerParams {
         Self {
             sides: 8,
             rows_per_segment: 2,
-            trunk_flare: 0.6,
-            trunk_lobes: 5.0,
-            trunk_lobe_depth: 0.07,
+            trunk_flare: 0.0,
+            trunk_lobes: 0.0,
+            trunk_lobe_depth: 0.0,
             lobe_fade: 1.0,
             bulges: 0.0,
             bulge_depth: 0.0,
+        }
+    }
+}
+
+impl DeformerParams {
+    /// The defaults with the trunk's shape from `tree`'s species ([`crate::model::TrunkShape`]).
+    pub fn for_tree(tree: &Tree) -> Self {
+        let t = &tree.trunk_shape;
+        Self {
+            trunk_flare: t.flare,
+            trunk_lobes: t.lobes as f32,
+            trunk_lobe_depth: t.lobe_depth,
+            bulges: t.bulges,
+            bulge_depth: t.bulge_depth,
+            ..Self::default()
         }
     }
 }
@@ -140,7 +159,11 @@ impl DeformLayout {
         for k in 0..st.len() {
             let first = st.first_segment[k] as usize;
             let n = st.segment_count[k] as usize;
-            let r = s.radius_base[first].max(1e-5);
+            let trunk = st.level[k] == 0;
+            // A trunk's segment radii already carry the species' flare: eq. 3 flares the
+            // unflared radius, so that flare is applied once.
+            let unflare = if trunk { tree.trunk_shape.flare_factor(0.0) } else { 1.0 };
+            let r = (s.radius_base[first] / unflare).max(1e-5);
             // Radius at mid-length along the chain.
             let half = 0.5 * st.length[k];
             let (mut acc, mut mid) = (0.0f32, s.radius_tip[first + n - 1]);
@@ -154,7 +177,6 @@ impl DeformLayout {
             }
             let m = (1.0 - mid / r).clamp(0.05, 0.95);
             let taper = (m.ln() / 0.5f32.ln()).clamp(0.2, 10.0);
-            let trunk = st.level[k] == 0;
             shapes.push(RawDeformShape {
                 radius: r,
                 taper,

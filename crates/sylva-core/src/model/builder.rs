@@ -299,7 +299,17 @@ impl TreeBuilder {
             None => 0,
             Some(l) => l.checked_add(1).ok_or(ModelError::TooLarge { what: "branch levels", count: 256 })?,
         };
-        let tree = Tree { name: name.to_string(), seed, levels, segments: seg, stems, leaves, children, wood };
+        let tree = Tree {
+            name: name.to_string(),
+            seed,
+            levels,
+            segments: seg,
+            stems,
+            leaves,
+            children,
+            wood,
+            trunk_shape: Default::default(),
+        };
         tree.validate()?;
         Ok(tree)
     }

@@ -221,6 +221,35 @@ pub struct Tree {
     pub children: Children,
     /// Wood properties used for mass and stiffness.
     pub wood: WoodProperties,
+    /// The trunk's cross-section as the species describes it (flare, lobes, bulges): what
+    /// the segment radii already hold (flare) and what only a mesher adds (lobes, bulges).
+    pub trunk_shape: TrunkShape,
+}
+
+/// The trunk's shape beyond its segments' radii (Weber–Penn `Flare`, `Lobes`, `LobeDepth`;
+/// Skjermo's bulges, eq. 4). Zero for L-system trees: a round, unflared trunk.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct TrunkShape {
+    /// Weber–Penn `Flare`: the base radius is `1 + 0.99 flare` times the unflared radius,
+    /// fading out over the lowest eighth of the trunk. Already in the segments' radii.
+    pub flare: f32,
+    /// Weber–Penn `Lobes` of the trunk's cross-section.
+    pub lobes: u32,
+    /// Weber–Penn `LobeDepth`: `1 + d sin(lobes θ)`.
+    pub lobe_depth: f32,
+    /// Skjermo's bulges along each stem (eq. 4, `b_n`).
+    pub bulges: f32,
+    /// Bulge depth (eq. 4, `b_d`).
+    pub bulge_depth: f32,
+}
+
+impl TrunkShape {
+    /// Weber–Penn's flare factor at height fraction `z` of the trunk:
+    /// `flare (100^y − 1) / 100 + 1`, `y = max(1 − 8z, 0)`.
+    pub fn flare_factor(&self, z: f32) -> f32 {
+        let y = (1.0 - 8.0 * z).max(0.0);
+        self.flare * (100f32.powf(y) - 1.0) / 100.0 + 1.0
+    }
 }
 
 /// Summary figures of a tree.

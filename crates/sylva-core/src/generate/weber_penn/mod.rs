@@ -511,6 +511,14 @@ impl WeberPennParams {
         if (z_scale - 1.0).abs() > 0.0 {
             b.scale_heights(z_scale);
         }
-        Ok(b.build(&p.name, seed, p.wood)?)
+        let mut tree = b.build(&p.name, seed, p.wood)?;
+        tree.trunk_shape = crate::model::TrunkShape {
+            flare: p.flare as f32,
+            lobes: p.lobes,
+            lobe_depth: p.lobe_depth as f32,
+            bulges: p.bulges as f32,
+            bulge_depth: p.bulge_depth as f32,
+        };
+        Ok(tree)
     }
 }

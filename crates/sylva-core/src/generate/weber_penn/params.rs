@@ -124,6 +124,13 @@ pub struct WeberPennParams {
     /// Flare: extra trunk radius at the base, fraction.
     #[serde(default)]
     pub flare: f64,
+    /// Bulges along each stem for Skjermo's deformer (eq. 4, `b_n`; not Weber–Penn's).
+    /// Default 0: none.
+    #[serde(default)]
+    pub bulges: f64,
+    /// Depth of the bulges (eq. 4, `b_d`), fraction of the radius, 0 to 0.9. Default 0.
+    #[serde(default)]
+    pub bulge_depth: f64,
     /// 0Scale: trunk radius scale.
     #[serde(default = "one")]
     pub trunk_scale: f64,
@@ -235,8 +242,11 @@ impl WeberPennParams {
         }
         range!(f("ratio"), self.ratio, 1e-6, 1.0);
         range!(f("ratio_power"), self.ratio_power, 0.0, 10.0);
-        range!(f("lobe_depth"), self.lobe_depth, 0.0, 1.0);
+        // Below 0.9: at depth 1 a lobed section pinches to a point.
+        range!(f("lobe_depth"), self.lobe_depth, 0.0, 0.89);
         range!(f("flare"), self.flare, 0.0, 10.0);
+        range!(f("bulges"), self.bulges, 0.0, 100.0);
+        range!(f("bulge_depth"), self.bulge_depth, 0.0, 0.89);
         range!(f("trunk_scale"), self.trunk_scale, 1e-6, 100.0);
         range!(f("trunk_scale_v"), self.trunk_scale_v, 0.0, 100.0);
         if self.trunk_scale_v >= self.trunk_scale {
