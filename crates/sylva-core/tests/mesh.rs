@@ -502,3 +502,38 @@ fn trunk_lobes_come_from_the_species() {
         }
     }
 }
+
+/// Zioma §6.5: a stem's base pairs with the branch one step higher in the hierarchy,
+/// weighted by distance from the branch's origin and by stiffness; a trunk's base with
+/// nothing. Every weight is in [0, ½].
+#[test]
+fn skinning_pairs_a_stem_base_with_its_parent_branch_by_stiffness() {
+    use sylva_core::mesh::SkinLayout;
+    use sylva_core::mesh::skin::base_weight;
+    let t = tree("black_tupelo");
+    let l = MeshLayout::new(&t, MeshParams::default()).unwrap();
+    let skin = SkinLayout::new(&l);
+    let stride = l.params.sides as usize + 1;
+    let (mut bases, mut hinged) = (0, 0);
+    for (r, ring) in l.rings.iter().enumerate() {
+        let b = skin.tube_skin[r * stride];
+        assert!((0.0..=0.5).contains(&b.weight), "ring {r}: weight {}", b.weight);
+        let i = ring.segment as usize;
+        let p = t.segments.parent[i];
+        if ring.t == 0.0 && ring.prev == sylva_core::NONE {
+            if p == sylva_core::NONE {
+                assert_eq!(b.weight, 0.0, "the trunk's base follows the trunk alone");
+                continue;
+            }
+            bases += 1;
+            let w = base_weight(t.segments.stiffness[i], t.segments.stiffness[p as usize]);
+            assert_eq!((b.bone1, b.weight), (p, 0.5 * w), "ring {r}: a stem's base ring");
+            hinged += usize::from(w < 0.5);
+        }
+    }
+    assert!(bases > 100, "the tupelo has many stems ({bases})");
+    assert!(hinged > 0, "some twigs are much more flexible than their parents and hinge");
+    assert_eq!(base_weight(1.0, 1.0), 1.0);
+    assert!((base_weight(1.0, 9.0) - 0.2).abs() < 1e-6);
+    assert_eq!(base_weight(0.0, 0.0), 0.0);
+}

@@ -7,8 +7,13 @@
 //! same transform that carries a leaf in [`crate::mesh::mesh_leaves`]. A bark vertex on a
 //! ring at parameter t of segment i blends segment i with its neighbour in the stem toward
 //! the nearer joint — weight ½ − t of the previous segment for t < ½, t − ½ of the next for
-//! t > ½ — so a joint ring is exactly half each and the skin bends smoothly there. A leaf
-//! vertex follows its segment alone.
+//! t > ½ — so a joint ring is exactly half each and the skin bends smoothly there. The
+//! lower half of a stem's first segment pairs with the branch it grows from, as Zioma pairs
+//! a vertex with "the branch one step higher in the hierarchy", weighted by distance from
+//! the branch's origin and by stiffness: `(½ − t) · min(1, 2k / (k + k_parent))`, so a
+//! twig much more flexible than its parent hinges at its base and one as stiff bends with
+//! it. A trunk's base pairs with nothing (the paper's identity). A leaf vertex follows its
+//! segment alone.
 //!
 //! The CPU reference `mesh::skin_vertices` is the twin of `skin_vertices.wgsl`; both write
 //! instance-major output (`instance × vertices + vertex`) from instance-major poses.
@@ -46,6 +51,12 @@ pub struct RawSkinInfo {
     pub first_instance: u32,
 }
 
+/// How much a stem's base follows the branch it grows from, 0…1: `min(1, 2k / (k + k_p))`
+/// for stiffnesses k (the stem's first segment) and k_p (the parent segment).
+pub fn base_weight(k: f32, k_parent: f32) -> f32 {
+    if k + k_parent > 0.0 && (k + k_parent).is_finite() { (2.0 * k / (k + k_parent)).min(1.0) } else { 0.0 }
+}
+
 /// A rest mesh with its bone weights, bark and leaves in separate ranges (as
 /// [`super::MeshFrame`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -73,9 +84,13 @@ impl SkinLayout {
         let rest = layout.mesh_raw(&joint, &acc);
         let stride = layout.params.sides as usize + 1;
         let mut tube_skin = Vec::with_capacity(rest.tubes.len());
+        let segments = &layout.segments;
         let bones = |r: &super::RawRing, t: f32| {
+            let own = &segments[r.segment as usize];
             let (bone1, weight) = if t < 0.5 && r.prev != NONE {
                 (r.prev, 0.5 - t)
+            } else if t < 0.5 && own.parent != NONE {
+                (own.parent, (0.5 - t) * base_weight(own.stiffness, segments[own.parent as usize].stiffness))
             } else if t > 0.5 && r.next != NONE {
                 (r.next, t - 0.5)
             } else {
