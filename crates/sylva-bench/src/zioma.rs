@@ -8,7 +8,9 @@
 //! - **pose**: every instance's branch rotations and forward kinematics (CPU: rayon; GPU: one
 //!   dispatch over all instances' segments and one forward-kinematics pass);
 //! - **frame**: pose and two-bone skinning of every instance's copy of the rest mesh — what
-//!   the paper's DirectX columns measure;
+//!   the paper's DirectX columns measure — at SLOD3 (trunk and branches);
+//! - **SLOD2 frame**: the same with the trunk alone simulated ([`Lod::TrunkOnly`]), the
+//!   paper's DirectX 10 SLOD2 column;
 //! - **skinning only**: skinning from a fixed pose, the paper's "two-bone skinning without
 //!   branch simulation" column.
 
@@ -22,7 +24,7 @@ use plotters::style::RGBColor;
 use serde::Serialize;
 use std::path::PathBuf;
 use sylva_core::mesh::{MeshLayout, MeshParams, RawVertex, SkinLayout};
-use sylva_core::methods::zioma::{Zioma, ZiomaInstance, ZiomaParams};
+use sylva_core::methods::zioma::{Lod, Zioma, ZiomaInstance, ZiomaParams};
 use sylva_core::pose::{Pose, seam_buffers};
 use sylva_core::wind::WindScene;
 use sylva_core::{Grammar, LSystemOptions, Tree};
@@ -45,8 +47,10 @@ pub struct ZiomaRow {
     pub vertices_per_instance: usize,
     /// The paper's DirectX 9 ms per frame.
     pub paper_dx9_ms: f64,
-    /// The paper's DirectX 10 ms per frame.
+    /// The paper's DirectX 10 ms per frame at SLOD3 (trunk and branches).
     pub paper_dx10_ms: f64,
+    /// The paper's DirectX 10 ms per frame at SLOD2 (trunk only).
+    pub paper_dx10_slod2_ms: f64,
     /// The paper's skinning-only ms per frame.
     pub paper_skin_ms: f64,
     /// Bytes read and written per frame (pose and skinning, each buffer once).
@@ -55,12 +59,16 @@ pub struct ZiomaRow {
     pub cpu_pose_ms: Option<[f64; 3]>,
     /// CPU pose + skinning ms.
     pub cpu_frame_ms: Option<[f64; 3]>,
+    /// CPU pose (trunk only) + skinning ms.
+    pub cpu_frame_slod2_ms: Option<[f64; 3]>,
     /// CPU skinning only ms.
     pub cpu_skin_ms: Option<[f64; 3]>,
     /// GPU pose ms.
     pub gpu_pose_ms: Option<[f64; 3]>,
     /// GPU pose + skinning ms.
     pub gpu_frame_ms: Option<[f64; 3]>,
+    /// GPU pose (trunk only) + skinning ms.
+    pub gpu_frame_slod2_ms: Option<[f64; 3]>,
     /// GPU skinning only ms.
     pub gpu_skin_ms: Option<[f64; 3]>,
     /// How the GPU was timed.
@@ -91,6 +99,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     let (fields, waves) = wind.pack();
     let (tree, layout, skin) = eighty()?;
     let z = Zioma::new(&tree, ZiomaParams::default());
+    let z2 = Zioma::new(&tree, ZiomaParams { lod: Lod::TrunkOnly, ..ZiomaParams::default() });
     let n_seg = tree.segments.len();
     let verts = skin.tube_rest.len();
     let bar = ProgressBar::new(rows.len() as u64).with_style(
@@ -98,7 +107,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     );
     bar.set_message("zioma-t6-1");
     let mut out = Vec::new();
-    for &(instances, paper_branches, paper_dx9_ms, paper_dx10_ms, paper_skin_ms) in rows {
+    for &(instances, paper_branches, paper_dx9_ms, paper_dx10_ms, paper_dx10_slod2_ms, paper_skin_ms) in rows {
         let placed = ZiomaInstance::grid(instances, 8.0, 1);
         // Pose: segments and stems read, rotations written then read, joints and
         // accumulated rotations written. Skinning: rest vertex and weights read, vertex written.
@@ -114,7 +123,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         };
         let rest_delta = vec![[0.0f32, 0.0, 0.0, 1.0]; n_seg * instances];
         let (rest_joint, rest_acc) = seam_buffers(&tree, &rest_delta);
-        let (cpu_pose, cpu_frame, cpu_skin) = if env.time_cpu {
+        let (cpu_pose, cpu_frame, cpu_frame_slod2, cpu_skin) = if env.time_cpu {
             let pose = measure(env.budget, |n| {
                 for _ in 0..n {
                     let d = z.rotations_instances(&tree, &fields, &waves, tick(), &placed);
@@ -122,34 +131,42 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                 }
                 Ok(())
             })?;
-            let frame = measure(env.budget, |n| {
-                for _ in 0..n {
-                    let d = z.rotations_instances(&tree, &fields, &waves, tick(), &placed);
-                    let (joint, acc) = seam_buffers(&tree, &d);
-                    std::hint::black_box(skin.skin(&joint, &acc, instances as u32));
-                }
-                Ok(())
-            })?;
+            let mut frame = |z: &Zioma| {
+                measure(env.budget, |n| {
+                    for _ in 0..n {
+                        let d = z.rotations_instances(&tree, &fields, &waves, tick(), &placed);
+                        let (joint, acc) = seam_buffers(&tree, &d);
+                        std::hint::black_box(skin.skin(&joint, &acc, instances as u32));
+                    }
+                    Ok(())
+                })
+            };
+            let (frame, frame_slod2) = (frame(&z)?, frame(&z2)?);
             let skin_only = measure(env.budget, |n| {
                 for _ in 0..n {
                     std::hint::black_box(skin.skin(&rest_joint, &rest_acc, instances as u32));
                 }
                 Ok(())
             })?;
-            (Some(pose), Some(frame), Some(skin_only))
+            (Some(pose), Some(frame), Some(frame_slod2), Some(skin_only))
         } else {
-            (None, None, None)
+            (None, None, None, None)
         };
         let mut gpu_skin_skipped = None;
-        let (gpu_pose, gpu_frame, gpu_skin) = match env.ctx {
+        let (gpu_pose, gpu_frame, gpu_frame_slod2, gpu_skin) = match env.ctx {
             Some(c) => {
-                let mut g = sylva_gpu::methods::zioma::GpuZioma::with_instances(
-                    c,
-                    std::sync::Arc::new(tree.clone()),
-                    z.clone(),
-                    &sylva_gpu::wind::GpuWind::from_scene(c, &wind)?,
-                    &placed,
-                )?;
+                let gpu_wind = sylva_gpu::wind::GpuWind::from_scene(c, &wind)?;
+                let shared = std::sync::Arc::new(tree.clone());
+                let new = |z: &Zioma| {
+                    sylva_gpu::methods::zioma::GpuZioma::with_instances(
+                        c,
+                        shared.clone(),
+                        z.clone(),
+                        &gpu_wind,
+                        &placed,
+                    )
+                };
+                let (mut g, mut g2) = (new(&z)?, new(&z2)?);
                 let pose = measure_gpu(env.budget, c, |n| {
                     for _ in 0..n {
                         g.submit(c, tick());
@@ -165,17 +182,21 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                     }
                     Err(e) => return Err(e).context("skinning every instance on the GPU"),
                 };
-                let (frame, skin_only) = match gs {
+                let (frame, frame_slod2, skin_only) = match gs {
                     Some(gs) => {
-                        let frame = measure_gpu(env.budget, c, |n| {
-                            for _ in 0..n {
-                                g.submit(c, tick());
-                                let mut e = c.device.create_command_encoder(&Default::default());
-                                gs.record(c, &mut e, g.pose_buffers().joints_buffer(), g.pose_buffers().acc_buffer());
-                                c.queue.submit([e.finish()]);
-                            }
-                            Ok(())
-                        })?;
+                        let mut frame = |g: &mut sylva_gpu::methods::zioma::GpuZioma| {
+                            measure_gpu(env.budget, c, |n| {
+                                for _ in 0..n {
+                                    g.submit(c, tick());
+                                    let mut e = c.device.create_command_encoder(&Default::default());
+                                    let pose = g.pose_buffers();
+                                    gs.record(c, &mut e, pose.joints_buffer(), pose.acc_buffer());
+                                    c.queue.submit([e.finish()]);
+                                }
+                                Ok(())
+                            })
+                        };
+                        let (frame, frame_slod2) = (frame(&mut g)?, frame(&mut g2)?);
                         let jb = sylva_gpu::kernel::upload(c, "rest joints", &rest_joint)?;
                         let ab = sylva_gpu::kernel::upload(c, "rest rotations", &rest_acc)?;
                         let skin_only = measure_gpu(env.budget, c, |n| {
@@ -186,13 +207,13 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                             c.queue.submit([e.finish()]);
                             Ok(())
                         })?;
-                        (Some(frame), Some(skin_only))
+                        (Some(frame), Some(frame_slod2), Some(skin_only))
                     }
-                    None => (None, None),
+                    None => (None, None, None),
                 };
-                (Some(pose), frame, skin_only)
+                (Some(pose), frame, frame_slod2, skin_only)
             }
-            None => (None, None, None),
+            None => (None, None, None, None),
         };
         let row = ZiomaRow {
             instances,
@@ -201,13 +222,16 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             vertices_per_instance: verts,
             paper_dx9_ms,
             paper_dx10_ms,
+            paper_dx10_slod2_ms,
             paper_skin_ms,
             bytes_per_frame: bytes,
             cpu_pose_ms: cpu_pose.map(|r| r.ms()),
             cpu_frame_ms: cpu_frame.map(|r| r.ms()),
+            cpu_frame_slod2_ms: cpu_frame_slod2.map(|r| r.ms()),
             cpu_skin_ms: cpu_skin.map(|r| r.ms()),
             gpu_pose_ms: gpu_pose.map(|r| r.ms()),
             gpu_frame_ms: gpu_frame.map(|r| r.ms()),
+            gpu_frame_slod2_ms: gpu_frame_slod2.map(|r| r.ms()),
             gpu_skin_ms: gpu_skin.map(|r| r.ms()),
             gpu_clock: gpu_pose.map(|r| r.clock),
             gpu_skin_skipped,
@@ -217,14 +241,18 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         debug_assert_eq!(row.branches, paper_branches);
         bar.suspend(|| {
             println!(
-                "{:>5} instances ({} branches): CPU pose {} ms, frame {} ms; GPU pose {} ms, frame {} ms (paper DX10 {:.2} ms)",
+                "{:>5} instances ({} branches): CPU pose {} ms, frame {} ms (SLOD2 {}); GPU pose {} ms, frame {} ms \
+                 (SLOD2 {}); paper DX10 {:.2} ms (SLOD2 {:.2})",
                 row.instances,
                 row.branches,
                 cell(row.cpu_pose_ms),
                 cell(row.cpu_frame_ms),
+                cell(row.cpu_frame_slod2_ms),
                 cell(row.gpu_pose_ms),
                 cell(row.gpu_frame_ms),
-                row.paper_dx10_ms
+                cell(row.gpu_frame_slod2_ms),
+                row.paper_dx10_ms,
+                row.paper_dx10_slod2_ms
             )
         });
         out.push(row);
@@ -237,31 +265,36 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     md += &format!(
         "ms per frame, median (fastest–slowest). An 80-branch tree ({n_seg} segments, {verts} skinned vertices per \
          instance; the paper: 4,617). Frame = pose + two-bone skinning of every instance (the paper's DirectX \
-         columns, Xeon 2.33 GHz + GeForce 8800 GTX); skinning only = from a fixed pose (the paper's skinning \
-         without branch simulation).\n\n"
+         columns, Xeon 2.33 GHz + GeForce 8800 GTX) at SLOD3 (trunk and branches) and SLOD2 (trunk only); \
+         skinning only = from a fixed pose (the paper's skinning without branch simulation).\n\n"
     );
-    md += "| instances | branches | paper DX9 ms | paper DX10 ms | paper skinning ms | MB/frame | CPU pose ms | CPU frame ms | CPU skinning ms | CPU frame / paper DX10 | CPU % of bandwidth | GPU pose ms | GPU frame ms | GPU skinning ms | GPU frame / paper DX10 | GPU % of bandwidth | CPU / GPU frame |\n";
-    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    md += "| instances | branches | paper DX9 ms | paper DX10 SLOD3 ms | paper DX10 SLOD2 ms | paper skinning ms | MB/frame | CPU pose ms | CPU frame ms | CPU SLOD2 frame ms | CPU skinning ms | CPU frame / paper DX10 | CPU SLOD2 / paper SLOD2 | CPU % of bandwidth | GPU pose ms | GPU frame ms | GPU SLOD2 frame ms | GPU skinning ms | GPU frame / paper DX10 | GPU SLOD2 / paper SLOD2 | GPU % of bandwidth | CPU / GPU frame |\n";
+    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let over = |a: Option<[f64; 3]>, b: f64| a.map_or("–".into(), |a| format!("{:.2}", a[0] / b));
     let pct = |f: Option<f64>| f.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f));
     for r in &out {
         md += &format!(
-            "| {} | {} | {:.2} | {:.2} | {:.2} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.instances,
             r.branches,
             r.paper_dx9_ms,
             r.paper_dx10_ms,
+            r.paper_dx10_slod2_ms,
             r.paper_skin_ms,
             r.bytes_per_frame as f64 / 1e6,
             cell(r.cpu_pose_ms),
             cell(r.cpu_frame_ms),
+            cell(r.cpu_frame_slod2_ms),
             cell(r.cpu_skin_ms),
             over(r.cpu_frame_ms, r.paper_dx10_ms),
+            over(r.cpu_frame_slod2_ms, r.paper_dx10_slod2_ms),
             pct(r.cpu_bandwidth_fraction),
             cell(r.gpu_pose_ms),
             cell(r.gpu_frame_ms),
+            cell(r.gpu_frame_slod2_ms),
             cell(r.gpu_skin_ms),
             over(r.gpu_frame_ms, r.paper_dx10_ms),
+            over(r.gpu_frame_slod2_ms, r.paper_dx10_slod2_ms),
             pct(r.gpu_bandwidth_fraction),
             match (r.cpu_frame_ms, r.gpu_frame_ms) {
                 (Some(c), Some(g)) => format!("{:.2}", c[0] / g[0]),
@@ -290,9 +323,16 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             RGBColor(120, 120, 120),
             out.iter().map(|r| (r.instances as f64, r.paper_dx10_ms)).collect(),
         ),
+        (
+            "paper DX10 SLOD2",
+            RGBColor(180, 180, 180),
+            out.iter().map(|r| (r.instances as f64, r.paper_dx10_slod2_ms)).collect(),
+        ),
         ("CPU frame", RGBColor(200, 60, 40), pick(|r| r.cpu_frame_ms)),
+        ("CPU SLOD2 frame", RGBColor(240, 120, 100), pick(|r| r.cpu_frame_slod2_ms)),
         ("CPU pose", RGBColor(230, 140, 60), pick(|r| r.cpu_pose_ms)),
         ("GPU frame", RGBColor(40, 90, 200), pick(|r| r.gpu_frame_ms)),
+        ("GPU SLOD2 frame", RGBColor(120, 150, 240), pick(|r| r.gpu_frame_slod2_ms)),
         ("GPU pose", RGBColor(90, 160, 230), pick(|r| r.gpu_pose_ms)),
     ];
     plot_series("Zioma Table 6-1 — pose and skinning per frame", "instances", "ms per frame", series, &png_path)

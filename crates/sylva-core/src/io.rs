@@ -524,7 +524,7 @@ fn find_field(text: &str, field: &str) -> (Option<usize>, usize) {
         },
         None => (String::new(), None, field),
     };
-    let key = key.split('[').next().unwrap_or(key);
+    let key = key.split(['[', '.']).next().unwrap_or(key);
     let mut in_table = table.is_empty();
     let mut seen = 0usize;
     let mut table_line = 1;

@@ -18,6 +18,8 @@ fn two_waves(sharpness: Option<f32>) -> WindScene {
             SineWave { amplitude: 1.0, direction_deg: 120.0, wavelength: 25.0, speed: 5.0 },
         ],
         sharpness,
+        fade_in: None,
+        fade_out: None,
     }))
 }
 
@@ -48,6 +50,8 @@ fn sharpness_above_one_sharpens_peaks_and_flattens_troughs() {
         one(WindField::SumOfSines(SumOfSines {
             waves: vec![SineWave { amplitude: 1.0, direction_deg: 0.0, wavelength: 10.0, speed: 10.0 }],
             sharpness: Some(k),
+            fade_in: None,
+            fade_out: None,
         }))
     };
     // One period (1 s) at the origin, 10,000 samples.
@@ -208,6 +212,8 @@ fn spectral_slope(beta: f32) -> f64 {
         vertical: 0.3,
         seed: 3,
         direction_deg: None,
+        fade_in: None,
+        fade_out: None,
     };
     spectral_slope_of(turb, 0.02, 3.0)
 }
@@ -233,6 +239,8 @@ fn turbulence_has_the_requested_intensity_and_is_spatially_coherent() {
         vertical: 0.3,
         seed: 9,
         direction_deg: None,
+        fade_in: None,
+        fade_out: None,
     };
     let scene = one(WindField::Turbulence(turb));
     let (f, w) = scene.pack();
@@ -450,4 +458,105 @@ fn gusty_turbulence_has_the_configured_spectral_slope() {
     let slope = spectral_slope_of(t.clone(), 0.03, 3.0);
     println!("gusty turbulence: fitted slope {slope:.3}, configured −{:.3}", t.beta);
     assert!((slope + t.beta as f64).abs() < 0.1, "slope {slope}, β {}", t.beta);
+}
+
+/// The packed envelope of a wave field: exactly 1 without fades (so a scene without them
+/// samples as it did, bit for bit), a smoothstep in and out with them.
+#[test]
+fn a_fade_is_a_smoothstep_and_no_fade_is_exactly_one() {
+    use sylva_core::wind::sample::wave_envelope;
+    let none = Fade::envelope(None, None);
+    for t in [-1e7f32, -3.5, 0.0, 1e-3, 17.25, 600.0, 1e7] {
+        assert_eq!(wave_envelope(none, t), 1.0, "t = {t}");
+    }
+    let b = Fade::envelope(Some(Fade { start: 10.0, duration: 2.0 }), Some(Fade { start: 20.0, duration: 4.0 }));
+    for (t, want) in
+        [(9.0, 0.0), (10.0, 0.0), (11.0, 0.5), (12.0, 1.0), (15.0, 1.0), (22.0, 0.5), (24.0, 0.0), (30.0, 0.0)]
+    {
+        assert!((wave_envelope(b, t) - want).abs() < 1e-6, "t = {t}: {} against {want}", wave_envelope(b, t));
+    }
+    let e = WindScene::from_toml(
+        "[[field]]\nkind = \"sum_of_sines\"\nwaves = []\nfade_in = { start = 1.0, duration = 0.0 }\n",
+        "w.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.starts_with("w.toml:4") && e.contains("field[0].fade_in.duration"), "{e}");
+}
+
+/// Skjermo §5: changing the waves at once jumps the wind; [`WindScene::blend_waves`] takes the
+/// old waves out over the blend, then brings the new ones in, so the wind never changes faster
+/// than its waves and the blend's own slope allow. Waves in both scenes are left alone.
+#[test]
+fn blending_takes_the_old_waves_out_before_the_new_ones_come_in() {
+    let sines = |a: f32, deg: f32, lambda: f32| {
+        WindField::SumOfSines(SumOfSines {
+            waves: vec![SineWave { amplitude: a, direction_deg: deg, wavelength: lambda, speed: 6.0 }],
+            sharpness: None,
+            fade_in: None,
+            fade_out: None,
+        })
+    };
+    let breeze = |s: f32| WindField::Constant(Constant { direction: [1.0, 0.0, 0.0], speed: s });
+    let turb = WindScene::resolve("gusty").unwrap().fields.into_iter().find(|f| matches!(f, WindField::Turbulence(_)));
+    let turb = turb.unwrap();
+    let old = WindScene { fields: vec![breeze(5.0), sines(2.0, 0.0, 20.0), turb.clone()] };
+    let next = WindScene { fields: vec![breeze(6.0), sines(2.5, 40.0, 13.0), turb.clone()] };
+    let (at, d) = (10.0f32, 1.5f32);
+    let blended = old.blend_waves(&next, at, d);
+    assert_eq!(blended.fields.len(), 4, "{blended:#?}");
+    assert_eq!(blended.fields[2], turb, "the unchanged turbulence is kept as it was");
+    let alone = |f: &WindField| WindScene { fields: vec![f.clone()] };
+    let p = Vec3::new(3.0, 5.0, -2.0);
+    let (gone, came) = (alone(&blended.fields[3]), alone(&blended.fields[1]));
+    for t in [0.0f32, 5.0, 9.99] {
+        assert_eq!(gone.sample(p, t), alone(&old.fields[1]).sample(p, t), "old waves at {t} s");
+        assert_eq!(came.sample(p, t), Vec3::ZERO, "new waves at {t} s");
+    }
+    for t in [at + d, 13.0, 30.0] {
+        assert_eq!(gone.sample(p, t), Vec3::ZERO, "old waves at {t} s");
+    }
+    for t in [at + 2.0 * d, 20.0, 30.0] {
+        assert_eq!(came.sample(p, t), alone(&next.fields[1]).sample(p, t), "new waves at {t} s");
+    }
+    // Rate of change through the blend: each wave's own (A ω) plus the envelope's
+    // (1.5 A / d at most), on top of the turbulence's, measured before the change.
+    let step = 1e-3f32;
+    let rate = |s: &WindScene, from: f32, to: f32| {
+        let n = ((to - from) / step) as usize;
+        (0..n)
+            .map(|k| {
+                let t = from + k as f32 * step;
+                ((s.sample(p, t + step) - s.sample(p, t)) / step).length()
+            })
+            .fold(0.0f32, f32::max)
+    };
+    let waves_only = |s: &WindScene| WindScene {
+        fields: s.fields.iter().filter(|f| matches!(f, WindField::SumOfSines(_))).cloned().collect(),
+    };
+    let omega = |a: f32, lambda: f32| a * std::f32::consts::TAU * 6.0 / lambda;
+    let bound = omega(2.0, 20.0).max(omega(2.5, 13.0)) + 1.5 * 2.5 / d;
+    let through = rate(&waves_only(&blended), at - 0.5, at + 2.0 * d + 0.5);
+    println!("waves' rate of change through the blend {through:.2} m/s², bound {bound:.2}");
+    assert!(through <= 1.02 * bound, "{through} m/s² against {bound}");
+    // At once, the waves jump (the test's measure sees it).
+    let abrupt = old.blend_waves(&next, at, 0.0);
+    assert_eq!(abrupt, next);
+    let jump = (waves_only(&abrupt).sample(p, at) - waves_only(&old).sample(p, at)).length();
+    assert!(jump / step > 10.0 * bound, "switching at once moves the wind only {jump} m/s");
+    // A second edit in the middle of a blend keeps the old waves on their way out as they
+    // were, drops the waves that had yet to come in, and brings the newest in after the blend.
+    let third = WindScene { fields: vec![breeze(6.0), sines(1.0, 90.0, 30.0), turb] };
+    let again = blended.blend_waves(&third, at + 0.5, d);
+    assert_eq!(again.fields.len(), 4, "{again:#?}");
+    assert_eq!(again.fields[3], blended.fields[3], "the old waves' blend out goes on as it was");
+    let (fade_in, _) = again.fields[1].fades().unwrap();
+    assert_eq!(fade_in, Some(Fade { start: at + 0.5 + d, duration: d }));
+    // Sixty edits a second (a dragged slider) keep one set going out and one coming in.
+    let mut dragged = again;
+    for k in 1..=120 {
+        let next = WindScene { fields: vec![breeze(6.0), sines(1.0 + 0.01 * k as f32, 90.0, 30.0)] };
+        dragged = dragged.blend_waves(&next, at + 0.5 + k as f32 / 60.0, d);
+        assert!(dragged.fields.len() <= 4, "edit {k}: {} fields", dragged.fields.len());
+    }
 }

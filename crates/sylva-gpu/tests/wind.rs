@@ -43,8 +43,11 @@ fn scenes(rng: &mut rand::rngs::StdRng) -> Vec<(&'static str, WindScene, f32, f3
         })
         .collect();
     let peak_s: f32 = waves.iter().map(|w| w.amplitude).sum();
-    let sines = SumOfSines { waves: waves.clone(), sharpness: None };
-    let sharp = SumOfSines { waves, sharpness: Some(r(1.5, 6.0)) };
+    // Sines and turbulence blend in and out within the samples' 0–120 s (Skjermo §5).
+    let mut fade = |from: f32| Some(Fade { start: from + r(0.0, 30.0), duration: r(1.0, 20.0) });
+    let (sines_in, sines_out, turb_in, turb_out) = (fade(0.0), fade(60.0), fade(0.0), fade(60.0));
+    let sines = SumOfSines { waves: waves.clone(), sharpness: None, fade_in: sines_in, fade_out: sines_out };
+    let sharp = SumOfSines { waves, sharpness: Some(r(1.5, 6.0)), fade_in: None, fade_out: None };
     let gust = GustFront {
         origin: [r(-100.0, 0.0), r(-50.0, 50.0)],
         direction_deg: r(0.0, 360.0),
@@ -87,17 +90,19 @@ fn scenes(rng: &mut rand::rngs::StdRng) -> Vec<(&'static str, WindScene, f32, f3
         vertical: 0.3,
         seed: 7,
         direction_deg: None,
+        fade_in: turb_in,
+        fade_out: turb_out,
     };
     let peak_t: f32 = turb.waves().iter().map(|w| Vec3::from_slice(&w.dir[..3]).length()).sum();
     let one = |f: WindField| WindScene { fields: vec![f] };
     vec![
         ("constant", one(WindField::Constant(constant)), peak_c, 1e-5),
-        ("sum of sines (eq. 13)", one(WindField::SumOfSines(sines)), peak_s, 1e-5),
+        ("sum of sines (eq. 13), fading in and out", one(WindField::SumOfSines(sines)), peak_s, 1e-5),
         ("sum of sines (eq. 14)", one(WindField::SumOfSines(sharp)), peak_s, 1e-5),
         ("gust front", one(WindField::GustFront(gust)), peak_g, 1e-5),
         ("vortex", one(WindField::Vortex(vortex)), peak_v, 1e-5),
         ("blast", one(WindField::Blast(blast)), peak_b, 1e-5),
-        ("turbulence", one(WindField::Turbulence(turb)), peak_t, 1e-5),
+        ("turbulence, fading in and out", one(WindField::Turbulence(turb)), peak_t, 1e-5),
     ]
 }
 

@@ -7,10 +7,15 @@
 //! points of the wind). A live effect placed at scene time t must reach every copy at t, so
 //! a group with a lead sees the effects shifted onto its own clock: one more packed scene
 //! and buffer pair per distinct lead, only while effects are live.
+//!
+//! An edit that changes the waves (sums of sines, turbulence) blends the old ones out, then
+//! the new ones in, over [`WorldWind::wave_blend`] each (Skjermo §5: a wave whose parameters
+//! change at once jumps the branches); the blends reach phase groups on their own clocks as
+//! effects do.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
-use sylva_core::wind::{Blast, Constant, GustFront, PackedWind, Vortex, WindField, WindScene};
+use sylva_core::wind::{Blast, Constant, Fade, GustFront, PackedWind, Vortex, WindField, WindScene};
 use sylva_gpu::wind::GpuWind;
 use sylva_gpu::{GpuContext, GpuError};
 
@@ -114,7 +119,16 @@ pub struct WorldWind {
     pub base_on: bool,
     /// An extra constant wind: direction (degrees from +X toward +Z) and speed (m/s).
     pub extra: Option<(f32, f32)>,
+    /// Seconds an edit takes to blend the old waves out, and again the new ones in.
+    /// Default 1 s: longer than a branch's period (under 1 s for trees over ~4 m), so the
+    /// wind's change is slow to the wood. 0 switches at once.
+    pub wave_blend: f32,
     effects: Vec<WindField>,
+    /// The steady wind as it blows: the scene's and the extra wind with the blends of edits
+    /// in progress ([`WindScene::blend_waves`]).
+    blowing: WindScene,
+    /// Which of `blowing`'s fields carry a blend made by an edit.
+    blended: Vec<bool>,
     composed: WindScene,
     scene_clock: ClockWind,
     /// Per lead (its bits): the scene with the effects shifted onto that clock.
@@ -127,10 +141,13 @@ impl WorldWind {
         let packed = Arc::new(base.packed());
         let gpu = GpuWind::new(ctx, packed.clone())?;
         Ok(Self {
+            blended: vec![false; base.fields.len()],
+            blowing: base.clone(),
             composed: base.clone(),
             base,
             base_on: true,
             extra: None,
+            wave_blend: 1.0,
             effects: Vec::new(),
             scene_clock: ClockWind { packed, gpu },
             leads: BTreeMap::new(),
@@ -154,13 +171,19 @@ impl WorldWind {
 
     /// The wind for a simulation whose clock runs `lead` seconds ahead of the scene's.
     pub(crate) fn clock(&mut self, ctx: &GpuContext, lead: f32) -> Result<ClockWind, GpuError> {
-        if lead == 0.0 || self.effects.is_empty() {
+        if lead == 0.0 || (self.effects.is_empty() && !self.blended.contains(&true)) {
             return Ok(self.scene_clock.clone());
         }
         if let Some(c) = self.leads.get(&lead.to_bits()) {
             return Ok(c.clone());
         }
-        let mut w = self.steady();
+        let mut w = self.blowing.clone();
+        for (f, _) in w.fields.iter_mut().zip(&self.blended).filter(|(_, b)| **b) {
+            if let Some((fade_in, fade_out)) = f.fades() {
+                let shift = |f: Option<Fade>| f.map(|f| Fade { start: f.start + lead, ..f });
+                f.set_fades(shift(fade_in), shift(fade_out));
+            }
+        }
         w.fields.extend(self.effects.iter().cloned().map(|mut f| {
             match &mut f {
                 WindField::Blast(b) => b.start += lead,
@@ -187,9 +210,16 @@ impl WorldWind {
     }
 
     /// Recomposes and re-uploads after any change of `base`, `base_on`, `extra` or the
-    /// effects.
-    pub(crate) fn recompose(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
-        let mut w = self.steady();
+    /// effects. With `blend_at`, changed waves blend from that scene time on
+    /// ([`Self::wave_blend`]); without, the steady wind is replaced at once.
+    pub(crate) fn recompose(&mut self, ctx: &GpuContext, blend_at: Option<f32>) -> Result<(), GpuError> {
+        let next = self.steady();
+        self.blowing = match blend_at {
+            Some(at) => self.blowing.blend_waves(&next, at, self.wave_blend),
+            None => next.clone(),
+        };
+        self.blended = self.blowing.fields.iter().enumerate().map(|(i, f)| next.fields.get(i) != Some(f)).collect();
+        let mut w = self.blowing.clone();
         w.fields.extend(self.effects.iter().cloned());
         let packed = Arc::new(w.packed());
         self.scene_clock.gpu.update(ctx, packed.clone())?;
@@ -209,11 +239,21 @@ impl WorldWind {
         self.effects.clear();
     }
 
-    /// Drops the effects that are over at scene time `t` (they would still cost a term per
-    /// sample); true when any was.
+    /// Drops the effects that are over at scene time `t`, and the waves blended out by then
+    /// (they would still cost a term per sample); true when any was.
     pub(crate) fn expire(&mut self, t: f32) -> bool {
-        let before = self.effects.len();
+        let before = (self.effects.len(), self.blowing.fields.len());
         self.effects.retain(|f| alive(f, t));
-        self.effects.len() != before
+        let mut keep = self.blowing.fields.iter().map(|f| !f.faded_out(t));
+        let blended = std::mem::take(&mut self.blended);
+        self.blended = blended.into_iter().filter(|_| keep.next().unwrap_or(true)).collect();
+        self.blowing.fields.retain(|f| !f.faded_out(t));
+        (self.effects.len(), self.blowing.fields.len()) != before
+    }
+
+    /// The steady wind as it blows now: the scene's and the extra wind, with the blends of
+    /// edits in progress.
+    pub fn blowing(&self) -> &WindScene {
+        &self.blowing
     }
 }

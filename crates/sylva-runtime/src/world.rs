@@ -116,10 +116,11 @@ impl World {
     /// Advances every simulation `steps` steps (GPU work submitted, not waited for); live
     /// effects that are over are dropped.
     pub fn step(&mut self, steps: usize) -> Result<(), RuntimeError> {
-        self.time += steps as f32 * self.dt;
+        // What is over when these steps start: a blend still has its tail to run.
         if self.wind.expire(self.time) {
             self.wind_changed()?;
         }
+        self.time += steps as f32 * self.dt;
         for t in &mut self.trees {
             t.advance(&self.ctx, self.dt, steps, false);
         }
@@ -196,7 +197,7 @@ impl World {
     }
 
     fn wind_changed(&mut self) -> Result<(), RuntimeError> {
-        self.wind.recompose(&self.ctx)?;
+        self.wind.recompose(&self.ctx, Some(self.time))?;
         for t in &mut self.trees {
             t.set_wind(&self.ctx, &mut self.wind)?;
         }
@@ -234,7 +235,7 @@ impl World {
             .map_err(|source| RuntimeError::SceneWind { file: scene.file.clone(), source: Box::new(source) })?;
         let old_scene = std::mem::replace(&mut self.scene, scene);
         let old_base = std::mem::replace(&mut self.wind.base, base);
-        let rebuilt = self.wind.recompose(&self.ctx).map_err(RuntimeError::from).and_then(|()| self.build_all());
+        let rebuilt = self.wind.recompose(&self.ctx, None).map_err(RuntimeError::from).and_then(|()| self.build_all());
         match rebuilt {
             Ok(mut trees) => {
                 for t in &mut trees {
@@ -246,7 +247,7 @@ impl World {
             Err(e) => {
                 self.scene = old_scene;
                 self.wind.base = old_base;
-                self.wind.recompose(&self.ctx)?;
+                self.wind.recompose(&self.ctx, None)?;
                 Err(e)
             }
         }

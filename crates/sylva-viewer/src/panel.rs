@@ -118,6 +118,18 @@ fn wind(ui: &mut egui::Ui, sim: &mut Session) {
         });
         sim.note(r);
     }
+    let mut blend = sim.world.wind().wave_blend;
+    if ui
+        .add(egui::Slider::new(&mut blend, 0.0..=5.0).text("wave blend s"))
+        .on_hover_text("an edit of the waves blends the old ones out, then the new ones in, over this time each")
+        .changed()
+    {
+        let r = sim.world.edit_wind(|w| {
+            w.wave_blend = blend;
+            false
+        });
+        sim.note(r);
+    }
     let mut edited = false;
     egui::CollapsingHeader::new("scene wind fields").show(ui, |ui| {
         let r = sim.world.edit_wind(|w| {

@@ -5,7 +5,7 @@
 //! Agrees with `wind_at` to the sine's error (tested).
 
 use crate::wind::raw::{RawField, RawWave, kind};
-use crate::wind::sample::field_at;
+use crate::wind::sample::{field_at, wave_envelope};
 use glam::Vec3;
 use std::f32::consts::TAU;
 use std::ops::{Add, Sub};
@@ -170,6 +170,7 @@ pub fn wind_lanes(fields: &[RawField], waves: &[RawWave], p: V3, t: f32) -> V3 {
             kind::SUM_OF_SINES => {
                 let (sharp, mode) = (f.a[0], f.a[1]);
                 let int_sharp = (sharp.fract() == 0.0 && (0.0..=16.0).contains(&sharp)).then_some(sharp as u32);
+                let e = V::splat(wave_envelope(f.b, t));
                 for w in &waves[f.wave_offset as usize..(f.wave_offset + f.wave_count) as usize] {
                     let th = p.x * w.k[0] + p.y * w.k[1] + p.z * w.k[2] + V::splat(w.k[3] * t);
                     let s = sin(th);
@@ -182,16 +183,17 @@ pub fn wind_lanes(fields: &[RawField], waves: &[RawWave], p: V3, t: f32) -> V3 {
                             None => base.powf(sharp),
                         }
                     };
-                    v = v.add(V3::splat(Vec3::new(w.dir[0], w.dir[1], w.dir[2])).scale(h));
+                    v = v.add(V3::splat(Vec3::new(w.dir[0], w.dir[1], w.dir[2])).scale(h * e));
                 }
             }
             kind::TURBULENCE => {
+                let e = V::splat(wave_envelope(f.b, t));
                 for w in &waves[f.wave_offset as usize..(f.wave_offset + f.wave_count) as usize] {
                     // The wave's phase in cycles depends on time only: once for all lanes.
                     let cyc = w.k[3] * t + w.phase[0];
                     let cyc = cyc - cyc.floor();
                     let th = V::splat(TAU * cyc) - (p.x * w.k[0] + p.y * w.k[1] + p.z * w.k[2]);
-                    v = v.add(V3::splat(Vec3::new(w.dir[0], w.dir[1], w.dir[2])).scale(sin(th)));
+                    v = v.add(V3::splat(Vec3::new(w.dir[0], w.dir[1], w.dir[2])).scale(sin(th) * e));
                 }
             }
             _ => {

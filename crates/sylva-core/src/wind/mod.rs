@@ -14,13 +14,20 @@
 //!   (Ota 2003), by spectral synthesis: log-spaced waves with amplitudes ∝ f^((1−β)/2),
 //!   advected at `mean_speed` (Taylor's frozen turbulence sets the spatial scale).
 //!
+//! The two wave fields (sums of sines and turbulence) may [`Fade`] in and out: Skjermo §5
+//! blends one set of waves out before the next comes in, since a wave whose parameters
+//! change at once jumps the branches ([`WindScene::blend_waves`]).
+//!
 //! Every field is evaluated through its packed form ([`raw`]) by [`crate::wind::sample`],
 //! the CPU twin of the WGSL kernel, so the friendly API and the GPU share one definition.
 
+pub mod fade;
 pub mod lanes;
 pub mod noise;
 pub mod raw;
 pub mod sample;
+
+pub use fade::Fade;
 
 use crate::rng::{Stream, mix64};
 use crate::wind::sample::wind_at;
@@ -66,6 +73,12 @@ pub struct SumOfSines {
     /// (control-polygon length) belongs to the bending method, not the field.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sharpness: Option<f32>,
+    /// The waves come in over this time (silent before it). Absent: always in.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fade_in: Option<Fade>,
+    /// The waves go out over this time (silent after it). Absent: never out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fade_out: Option<Fade>,
 }
 
 /// A travelling gust front.
@@ -171,6 +184,12 @@ pub struct Turbulence {
     /// Seed of the random phases and directions.
     #[serde(default)]
     pub seed: u64,
+    /// The waves come in over this time (silent before it). Absent: always in.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fade_in: Option<Fade>,
+    /// The waves go out over this time (silent after it). Absent: never out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fade_out: Option<Fade>,
 }
 
 fn one() -> f32 {
@@ -398,6 +417,14 @@ impl WindScene {
             let named = |vals: &mut Vec<(String, f32, f32, f32)>, list: &[(&str, f32, f32, f32)]| {
                 vals.extend(list.iter().map(|&(n, v, lo, hi)| (n.to_string(), v, lo, hi)));
             };
+            let fades = |vals: &mut Vec<(String, f32, f32, f32)>, fade_in: Option<Fade>, fade_out: Option<Fade>| {
+                for (name, f) in [("fade_in", fade_in), ("fade_out", fade_out)] {
+                    if let Some(f) = f {
+                        vals.push((format!("{name}.start"), f.start, -1e7, 1e7));
+                        vals.push((format!("{name}.duration"), f.duration, 1e-3, 1e7));
+                    }
+                }
+            };
             match f {
                 WindField::Constant(c) => {
                     named(&mut vals, &[("speed", c.speed, -1e3, 1e3)]);
@@ -415,6 +442,7 @@ impl WindScene {
                     if let Some(k) = s.sharpness {
                         named(&mut vals, &[("sharpness", k, 1e-3, 100.0)]);
                     }
+                    fades(&mut vals, s.fade_in, s.fade_out);
                     for (k, w) in s.waves.iter().enumerate() {
                         for (n, v, lo, hi) in [
                             ("amplitude", w.amplitude, -1e3, 1e3),
@@ -487,6 +515,7 @@ impl WindScene {
                     if let Some(d) = t.direction_deg {
                         named(&mut vals, &[("direction_deg", d, -1e4, 1e4)]);
                     }
+                    fades(&mut vals, t.fade_in, t.fade_out);
                     // Related only once each is in range (a non-finite or huge one is named).
                     let in_range = |f: f32| (1e-5..=1e3).contains(&f);
                     if in_range(t.f_min) && in_range(t.f_max) && t.f_max <= t.f_min {
@@ -530,6 +559,7 @@ impl WindScene {
                 WindField::SumOfSines(s) => {
                     r.kind = kind::SUM_OF_SINES;
                     r.a = [s.sharpness.unwrap_or(1.0), if s.sharpness.is_some() { 1.0 } else { 0.0 }, 0.0, 0.0];
+                    r.b = Fade::envelope(s.fade_in, s.fade_out);
                     for w in &s.waves {
                         let (dx, dz) = horizontal(w.direction_deg);
                         let wn = std::f32::consts::TAU / w.wavelength;
@@ -561,6 +591,7 @@ impl WindScene {
                 }
                 WindField::Turbulence(t) => {
                     r.kind = kind::TURBULENCE;
+                    r.b = Fade::envelope(t.fade_in, t.fade_out);
                     waves.extend(t.waves_along(self.mean_direction()));
                 }
             }

@@ -6,11 +6,11 @@
 //! | kind | `a` | `b` | `c` | waves |
 //! | --- | --- | --- | --- | --- |
 //! | constant | velocity xyz | – | – | – |
-//! | sum of sines | (k, mode, –, –) | – | – | `dir` = D (xz) · A, `k` = D w, `freq` = φ |
+//! | sum of sines | (k, mode, –, –) | fades (in start, 1/in duration, out start, 1/out duration) | – | `dir` = D (xz) · A, `k` = D w, `freq` = φ |
 //! | gust front | origin xz, direction xz | strength, speed, width, length | start, radius, –, – | – |
 //! | vortex | centre xz, drift xz | strength, radius, start, duration | fade, updraft, –, – | – |
 //! | blast | centre xyz, strength | start, speed, width, decay | radius, –, –, – | – |
-//! | turbulence | – | – | – | `dir` = u · a, `k` = wave vector, `freq` = f, `phase` |
+//! | turbulence | – | fades, as sum of sines | – | `dir` = u · a, `k` = wave vector, `freq` = f, `phase` |
 
 use bytemuck::{Pod, Zeroable};
 

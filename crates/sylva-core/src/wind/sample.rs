@@ -14,6 +14,18 @@ pub fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
     t * t * (3.0 - 2.0 * t)
 }
 
+/// The envelope of a wave field at `t` from its packed [`crate::wind::Fade`]s (`RawField::b`):
+/// a smoothstep in times one minus a smoothstep out; exactly 1 without fades. As
+/// `wave_envelope` in `wind.wgsl`.
+#[inline]
+pub fn wave_envelope(b: [f32; 4], t: f32) -> f32 {
+    let ramp = |x: f32| {
+        let c = x.clamp(0.0, 1.0);
+        c * c * (3.0 - 2.0 * c)
+    };
+    ramp((t - b[0]) * b[1]) * (1.0 - ramp((t - b[2]) * b[3]))
+}
+
 #[inline]
 fn v3(a: [f32; 4]) -> Vec3 {
     Vec3::new(a[0], a[1], a[2])
@@ -26,12 +38,13 @@ pub fn field_at(f: &RawField, waves: &[RawWave], p: Vec3, t: f32) -> Vec3 {
         kind::SUM_OF_SINES => {
             let sharp = f.a[0];
             let mode = f.a[1];
+            let e = wave_envelope(f.b, t);
             let mut v = Vec3::ZERO;
             for w in &waves[f.wave_offset as usize..(f.wave_offset + f.wave_count) as usize] {
                 let th = v3(w.k).dot(p) + w.k[3] * t;
                 let s = th.sin();
                 let h = if mode < 0.5 { s } else { ((s + 1.0) * 0.5).powf(sharp) };
-                v += v3(w.dir) * h;
+                v += v3(w.dir) * (h * e);
             }
             v
         }
@@ -83,12 +96,13 @@ pub fn field_at(f: &RawField, waves: &[RawWave], p: Vec3, t: f32) -> Vec3 {
             rel * (amp / d)
         }
         kind::TURBULENCE => {
+            let e = wave_envelope(f.b, t);
             let mut v = Vec3::ZERO;
             for w in &waves[f.wave_offset as usize..(f.wave_offset + f.wave_count) as usize] {
                 let cyc = w.k[3] * t + w.phase[0];
                 let cyc = cyc - cyc.floor();
                 let th = TAU * cyc - v3(w.k).dot(p);
-                v += v3(w.dir) * th.sin();
+                v += v3(w.dir) * (th.sin() * e);
             }
             v
         }
@@ -108,7 +122,9 @@ pub fn wind_at(fields: &[RawField], waves: &[RawWave], p: Vec3, t: f32) -> Vec3 
 /// The wind at `p` and `t` with each wave (sum of sines, turbulence) passed through a linear
 /// filter: `response(f)` gives the gain and the phase lag (rad) at `f` Hz. A sharpened sum of
 /// sines keeps its mean and filters what swings about it. Fields without waves pass through
-/// as they are. With `response` = (1, 0) it is [`wind_at`] (to rounding).
+/// as they are. With `response` = (1, 0) it is [`wind_at`] (to rounding). A field's
+/// [`wave_envelope`] scales its filtered waves at `t`: a blend as slow as the filter's memory
+/// (a fade of a second or more against a tree's damping) passes through nearly unchanged.
 pub fn wind_through(
     fields: &[RawField],
     waves: &[RawWave],
@@ -129,24 +145,26 @@ pub fn wind_through(
                     (0..64).map(|j| ((((j as f32 + 0.5) * TAU / 64.0).sin() + 1.0) * 0.5).powf(sharp)).sum::<f32>()
                         / 64.0
                 };
+                let e = wave_envelope(f.b, t);
                 let mut sum = Vec3::ZERO;
                 for w in run() {
                     let (gain, lag) = response(w.k[3].abs() / TAU);
                     let th = v3(w.k).dot(p) + w.k[3] * t - lag * w.k[3].signum();
                     let s = th.sin();
                     let h = if mode < 0.5 { s } else { ((s + 1.0) * 0.5).powf(sharp) - mean };
-                    sum += v3(w.dir) * (mean + gain * h);
+                    sum += v3(w.dir) * ((mean + gain * h) * e);
                 }
                 sum
             }
             kind::TURBULENCE => {
+                let e = wave_envelope(f.b, t);
                 let mut sum = Vec3::ZERO;
                 for w in run() {
                     let (gain, lag) = response(w.k[3]);
                     let cyc = w.k[3] * t + w.phase[0];
                     let cyc = cyc - cyc.floor();
                     let th = TAU * cyc - v3(w.k).dot(p) - lag;
-                    sum += v3(w.dir) * (gain * th.sin());
+                    sum += v3(w.dir) * (gain * th.sin() * e);
                 }
                 sum
             }

@@ -45,6 +45,13 @@ fn smooth_step(e0: f32, e1: f32, x: f32) -> f32 {
     return t * t * (3.0 - 2.0 * t);
 }
 
+// A wave field's blend in and out (`wave_envelope` in wind/sample.rs): exactly 1 without fades.
+fn wave_envelope(b: vec4<f32>, t: f32) -> f32 {
+    let i = clamp((t - b.x) * b.y, 0.0, 1.0);
+    let o = clamp((t - b.z) * b.w, 0.0, 1.0);
+    return (i * i * (3.0 - 2.0 * i)) * (1.0 - o * o * (3.0 - 2.0 * o));
+}
+
 fn field_at(f: Field, p: vec3<f32>, t: f32) -> vec3<f32> {
     switch f.kind {
         case KIND_CONSTANT: {
@@ -53,6 +60,7 @@ fn field_at(f: Field, p: vec3<f32>, t: f32) -> vec3<f32> {
         case KIND_SUM_OF_SINES: {
             let sharp = f.a.x;
             let mode = f.a.y;
+            let e = wave_envelope(f.b, t);
             var v = vec3<f32>(0.0);
             for (var i = f.wave_offset; i < f.wave_offset + f.wave_count; i++) {
                 let w = wind_waves[i];
@@ -62,7 +70,7 @@ fn field_at(f: Field, p: vec3<f32>, t: f32) -> vec3<f32> {
                 if (mode >= 0.5) {
                     h = pow((s + 1.0) * 0.5, sharp);
                 }
-                v += w.dir.xyz * h;
+                v += w.dir.xyz * (h * e);
             }
             return v;
         }
@@ -122,13 +130,14 @@ fn field_at(f: Field, p: vec3<f32>, t: f32) -> vec3<f32> {
             return rel * (amp / d);
         }
         case KIND_TURBULENCE: {
+            let e = wave_envelope(f.b, t);
             var v = vec3<f32>(0.0);
             for (var i = f.wave_offset; i < f.wave_offset + f.wave_count; i++) {
                 let w = wind_waves[i];
                 let c0 = w.k.w * t + w.phase.x;
                 let cyc = c0 - floor(c0);
                 let th = TAU * cyc - dot(w.k.xyz, p);
-                v += w.dir.xyz * sin_turns(th);
+                v += w.dir.xyz * (sin_turns(th) * e);
             }
             return v;
         }

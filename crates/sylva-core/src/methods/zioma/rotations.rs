@@ -64,8 +64,15 @@ pub fn zioma_rotation(
     let inertia = -f.inertia * f.trunk_rate / (std::f32::consts::TAU * stem.freq);
     let bend = theta * (facing * (0.9 + 0.1 * osc) + back * (0.4 + 0.8 * osc) + perp * (0.6 + 0.3 * osc))
         + inertia * f.amplitude;
-    let k = axis_or(dir.cross(w), axis_or(up.cross(w), Vec3::X));
-    let side = if pa.cross(dir).dot(w) >= 0.0 { 1.0 } else { -1.0 };
+    // The wind across the branch bends it (about dir × w); a branch along the wind has no
+    // cross flow, and its bend axis turns over as the wind passes its line: the bend fades
+    // with the cross flow there (within ±14°) instead of flipping sides at once.
+    let across = dir.cross(w);
+    let k = axis_or(across, axis_or(up.cross(w), Vec3::X));
+    let bend = bend * (4.0 * across.length()).min(1.0);
+    // Which way the wind swings the branch about its parent: a sign that turns over smoothly
+    // (within ±14° of the branch's plane) as the wind crosses the plane, not at once.
+    let side = (4.0 * axis_or(pa.cross(dir), Vec3::ZERO).dot(w)).clamp(-1.0, 1.0);
     let swing = side * perp * theta * (0.5 + 0.5 * osc2);
     let twist = perp * theta * 0.3 * osc2;
     Quat::from_axis_angle(k, bend * frac)

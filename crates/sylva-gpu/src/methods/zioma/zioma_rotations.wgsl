@@ -89,15 +89,16 @@ fn zioma_rotation(s: Segment, stem: ZiomaStem, f: ZiomaFrame) -> vec4<f32> {
     let osc2 = value_noise(2.7 * stem.freq * f.time + phase, stem.seed ^ 0x55u);
     let inertia = -f.inertia * f.trunk_rate / (TAU * stem.freq);
     let bend = theta * (facing * (0.9 + 0.1 * osc) + back * (0.4 + 0.8 * osc) + perp * (0.6 + 0.3 * osc)) + inertia * f.amplitude;
-    let k = axis_or(cross(dir, w), axis_or(cross(up, w), vec3<f32>(1.0, 0.0, 0.0)));
-    var side = -1.0;
-    if (dot(cross(pa, dir), w) >= 0.0) {
-        side = 1.0;
-    }
+    // The bend fades with the cross flow where the wind runs along the branch (rotations.rs).
+    let across = cross(dir, w);
+    let k = axis_or(across, axis_or(cross(up, w), vec3<f32>(1.0, 0.0, 0.0)));
+    let bend_across = bend * min(4.0 * length(across), 1.0);
+    // Turns over smoothly as the wind crosses the branch's plane (rotations.rs).
+    let side = clamp(4.0 * dot(axis_or(cross(pa, dir), vec3<f32>(0.0)), w), -1.0, 1.0);
     let swing = side * perp * theta * (0.5 + 0.5 * osc2);
     let twist = perp * theta * 0.3 * osc2;
     return quat_mul(
-        quat_mul(quat_axis_angle(k, bend * frac), quat_axis_angle(pa, swing * frac)),
+        quat_mul(quat_axis_angle(k, bend_across * frac), quat_axis_angle(pa, swing * frac)),
         quat_axis_angle(dir, twist * frac),
     );
 }

@@ -1,0 +1,149 @@
+//! Skjermo §5 in a running world: an edit that changes the waves blends the old ones out,
+//! then the new ones in, on every phase group's clock, and no tree jumps.
+
+mod common;
+
+use glam::Vec3;
+use sylva_core::scene::Scene;
+use sylva_core::wind::raw::kind;
+use sylva_core::wind::{WindField, WindScene};
+use sylva_runtime::World;
+
+/// A palm and a copy in the `gusty` wind under `method` on the CPU. Under Zioma (a closed form
+/// of the wind) a jump in the wind is a jump in the pose; under Akagi the copy is a phase
+/// group whose clock runs ahead of the scene's.
+fn world(ctx: &std::sync::Arc<sylva_gpu::GpuContext>, method: &str) -> World {
+    let text = format!(
+        "wind = \"gusty\"\n[output]\nsim_rate = 60\n[[tree]]\nspecies = \"palm\"\nmethod = \"{method}\"\n\
+         backend = \"cpu\"\ncopies = [{{ position = [6.0, 0.0, -4.0] }}]\n"
+    );
+    World::new(ctx.clone(), Scene::from_toml(&text, "blend.toml", std::path::Path::new(".")).unwrap()).unwrap()
+}
+
+/// The gusty scene with its sums of sines turned 90° and shortened: new waves.
+fn turned(base: &WindScene) -> WindScene {
+    let mut w = base.clone();
+    for f in &mut w.fields {
+        if let WindField::SumOfSines(s) = f {
+            for wave in &mut s.waves {
+                wave.direction_deg += 90.0;
+                wave.wavelength *= 0.5;
+            }
+        }
+    }
+    w
+}
+
+/// Runs `world` 4 s, turns the waves, runs 3 s more; per simulation (phase group), the trunk
+/// top's largest move in one step before the edit and after it (m).
+fn moves_around_an_edit(world: &mut World) -> Vec<(f32, f32)> {
+    let ctx = world.ctx().clone();
+    let sims = world.trees()[0].simulations().len();
+    let mut last: Vec<Option<Vec3>> = vec![None; sims];
+    let mut step = |world: &mut World| -> Vec<f32> {
+        world.step(1).unwrap();
+        let tree = &world.trees()[0];
+        let top = tree.tree.segments.len() - 1;
+        tree.simulations()
+            .iter()
+            .zip(&mut last)
+            .map(|(sim, last)| {
+                let end = sim.pose(&ctx).unwrap().end(&tree.tree, top);
+                let moved = last.map_or(0.0, |l| (end - l).length());
+                *last = Some(end);
+                moved
+            })
+            .collect()
+    };
+    let most = |steps: Vec<Vec<f32>>, s: usize| steps.iter().map(|m| m[s]).fold(0.0f32, f32::max);
+    let before: Vec<Vec<f32>> = (0..240).map(|_| step(world)).skip(60).collect();
+    world
+        .edit_wind(|w| {
+            w.base = turned(&w.base);
+            true
+        })
+        .unwrap();
+    let after: Vec<Vec<f32>> = (0..180).map(|_| step(world)).collect();
+    (0..sims).map(|s| (most(before.clone(), s), most(after.clone(), s))).collect()
+}
+
+#[test]
+fn an_edit_of_the_waves_blends_them_out_then_in_on_every_clock_without_a_jump() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut blended = world(&ctx, "zioma");
+    assert_eq!(blended.wind().wave_blend, 1.0);
+    let moves = moves_around_an_edit(&mut blended);
+    // The new waves are in, blended in from 1 s after the edit (at 4 s); the old ones are
+    // gone once their blend was over.
+    let (base, blowing) = (&blended.wind().base, blended.wind().blowing());
+    assert_eq!(blowing.fields.len(), base.fields.len(), "{blowing:#?}");
+    let sines = blowing.fields.iter().find(|f| matches!(f, WindField::SumOfSines(_))).unwrap();
+    let (fade_in, fade_out) = sines.fades().unwrap();
+    assert!(fade_in.is_some_and(|f| (f.start - 5.0).abs() < 1e-3 && f.duration == 1.0), "{fade_in:?}");
+    assert_eq!(fade_out, None);
+
+    let mut abrupt = world(&ctx, "zioma");
+    abrupt.edit_wind(|w| std::mem::replace(&mut w.wave_blend, 0.0) != 0.0).unwrap();
+    let jumps = moves_around_an_edit(&mut abrupt);
+    for (s, ((before, after), (abrupt_before, abrupt_after))) in moves.iter().zip(&jumps).enumerate() {
+        println!(
+            "phase group {s}: trunk top's largest step {before:.5} m before the edit, {after:.5} m after it \
+             blended; {abrupt_before:.5} / {abrupt_after:.5} m switched at once"
+        );
+        assert!(*after <= 1.25 * before, "group {s}: {after} m in a step after the blended edit, {before} m before");
+        assert!(*abrupt_after > 2.0 * abrupt_before, "group {s}: switching at once moved the top {abrupt_after} m");
+    }
+}
+
+/// While a blend runs, the outgoing waves are in the wind with their fade-out starting at the
+/// edit, on the scene's clock and shifted by its lead on each phase group's; a reload
+/// replaces the wind at once.
+#[test]
+fn the_outgoing_waves_blow_on_every_clock_until_their_blend_is_over() {
+    use sylva_runtime::Simulation;
+    let Some(ctx) = common::gpu() else { return };
+    let mut world = world(&ctx, "akagi");
+    assert!(world.trees()[0].has_leads(), "the copy should run ahead of the scene's clock");
+    world.preroll(30);
+    let at = world.time();
+    world
+        .edit_wind(|w| {
+            w.base = turned(&w.base);
+            true
+        })
+        .unwrap();
+    let n = world.wind().base.fields.len();
+    let outgoing = world.wind().blowing().fields[n..].to_vec();
+    assert_eq!(outgoing.len(), 1, "{:#?}", world.wind().blowing());
+    let out = outgoing[0].fades().unwrap().1.unwrap();
+    assert!((out.start - at).abs() < 1e-5 && out.duration == 1.0, "{out:?}");
+    let mut leads = Vec::new();
+    for sim in world.trees()[0].simulations() {
+        let Simulation::Cpu(a) = sim else { panic!("a CPU scene") };
+        let lead = a.time() - world.time();
+        // The packed fade-out start of the outgoing sines (`Fade::envelope`'s third slot).
+        let waves = a.wind().fields.iter().filter(|f| [kind::SUM_OF_SINES, kind::TURBULENCE].contains(&f.kind));
+        let starts: Vec<f32> = waves.map(|f| f.b[2]).filter(|s| s.abs() < 1e29).collect();
+        assert_eq!(starts.len(), 1, "lead {lead} s: {starts:?}");
+        assert!(
+            (starts[0] - (at + lead)).abs() < 1e-3,
+            "lead {lead} s: its blend starts at {} s, the edit at {at} s",
+            starts[0]
+        );
+        leads.push(lead);
+    }
+    assert!(leads.iter().any(|l| *l > 0.5), "no phase group ahead: {leads:?}");
+    world.step(60).unwrap();
+    assert_eq!(world.wind().blowing().fields.len(), n + 1, "gone before its blend was over");
+    world.step(2).unwrap();
+    assert_eq!(world.wind().blowing().fields.len(), n, "still there after its blend");
+    let scene = world.scene().clone();
+    world
+        .edit_wind(|w| {
+            w.base = turned(&w.base);
+            true
+        })
+        .unwrap();
+    world.set_scene(scene).unwrap();
+    assert_eq!(world.wind().blowing(), &world.wind().base, "a reload blends nothing");
+}
