@@ -244,10 +244,8 @@ impl WorldWind {
     pub(crate) fn expire(&mut self, t: f32) -> bool {
         let before = (self.effects.len(), self.blowing.fields.len());
         self.effects.retain(|f| alive(f, t));
-        let mut keep = self.blowing.fields.iter().map(|f| !f.faded_out(t));
-        let blended = std::mem::take(&mut self.blended);
-        self.blended = blended.into_iter().filter(|_| keep.next().unwrap_or(true)).collect();
-        self.blowing.fields.retain(|f| !f.faded_out(t));
+        let fields = std::mem::take(&mut self.blowing.fields).into_iter().zip(std::mem::take(&mut self.blended));
+        (self.blowing.fields, self.blended) = fields.filter(|(f, _)| !f.faded_out(t)).unzip();
         (self.effects.len(), self.blowing.fields.len()) != before
     }
 

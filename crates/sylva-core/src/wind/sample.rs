@@ -19,11 +19,7 @@ pub fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 /// `wave_envelope` in `wind.wgsl`.
 #[inline]
 pub fn wave_envelope(b: [f32; 4], t: f32) -> f32 {
-    let ramp = |x: f32| {
-        let c = x.clamp(0.0, 1.0);
-        c * c * (3.0 - 2.0 * c)
-    };
-    ramp((t - b[0]) * b[1]) * (1.0 - ramp((t - b[2]) * b[3]))
+    smoothstep(0.0, 1.0, (t - b[0]) * b[1]) * (1.0 - smoothstep(0.0, 1.0, (t - b[2]) * b[3]))
 }
 
 #[inline]

@@ -47,9 +47,7 @@ fn smooth_step(e0: f32, e1: f32, x: f32) -> f32 {
 
 // A wave field's blend in and out (`wave_envelope` in wind/sample.rs): exactly 1 without fades.
 fn wave_envelope(b: vec4<f32>, t: f32) -> f32 {
-    let i = clamp((t - b.x) * b.y, 0.0, 1.0);
-    let o = clamp((t - b.z) * b.w, 0.0, 1.0);
-    return (i * i * (3.0 - 2.0 * i)) * (1.0 - o * o * (3.0 - 2.0 * o));
+    return smooth_step(0.0, 1.0, (t - b.x) * b.y) * (1.0 - smooth_step(0.0, 1.0, (t - b.z) * b.w));
 }
 
 fn field_at(f: Field, p: vec3<f32>, t: f32) -> vec3<f32> {
