@@ -38,7 +38,7 @@ pub struct TreeWindArgs {
     /// Animation method.
     #[arg(long, default_value = "zioma", value_parser = clap::builder::PossibleValuesParser::new(BUILTIN.map(|e| e.name)))]
     pub method: String,
-    /// A wind preset (`gusty`, `blast`) or a scene TOML file.
+    /// A wind preset (`gusty`, `blast`, `eddies`) or a scene TOML file.
     #[arg(long, default_value = "gusty")]
     pub wind: String,
     /// A method parameter as `name=value` (TOML value: `damping_ratio=0.1`, `lod="trunk_only"`);

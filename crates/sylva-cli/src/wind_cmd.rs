@@ -19,7 +19,7 @@ type Component = Box<dyn Fn(&[f32; 4], f32) -> f32>;
 /// Arguments of `sylva wind`.
 #[derive(clap::Args, Debug)]
 pub struct WindArgs {
-    /// A wind preset (`gusty`, `blast`) or a scene TOML file.
+    /// A wind preset (`gusty`, `blast`, `eddies`) or a scene TOML file.
     #[arg(long, default_value = "gusty")]
     pub scene: String,
     /// Point for the speed plot, `x,y,z` in metres.

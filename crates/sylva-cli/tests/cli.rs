@@ -1097,3 +1097,33 @@ fn species_names_paths_and_output_read_as_a_user_writes_them() {
         sylva(dir.path(), &["generate", "--species", "ternary", "--iterations", "3", "--max-iterations", "100000"]);
     assert!(ok, "the flag the hint names exists: {err}");
 }
+
+/// Zioma §6.3.1's wind grid from the command line: the shipped `eddies` preset by name from
+/// outside the repository, and a user's own grid beside their wind file, read from elsewhere.
+#[test]
+fn a_wind_grid_moves_trees_from_a_preset_and_from_a_file_beside_the_wind_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = sylva(
+        dir.path(),
+        &["simulate", "--species", "monopodial", "--wind", "eddies", "--seconds", "2", "--fps", "30"],
+    );
+    assert!(ok, "{err}");
+    assert!(!out.contains("largest segment-end speed 0.000 m/s"), "{out}");
+    let (ok, out, err) = sylva(dir.path(), &["wind", "--scene", "eddies", "--to", "10", "--out-dir", "plots"]);
+    assert!(ok && out.contains("wind_field.png"), "{err}");
+    // A 2 × 1 × 2 grid of 6 m/s along +z, only the grid: the wind file names it relatively.
+    std::fs::create_dir(dir.path().join("winds")).unwrap();
+    let grid = sylva_core::wind::GridData::new([2, 1, 2], 1, vec![[0.0, 0.0, 6.0]; 4]).unwrap();
+    std::fs::write(dir.path().join("winds/g.swg"), grid.to_raw()).unwrap();
+    let text = "[[field]]\nkind = \"grid\"\nfile = \"g.swg\"\ncell = [10.0, 1.0, 10.0]\n";
+    std::fs::write(dir.path().join("winds/w.toml"), text).unwrap();
+    let args = ["simulate", "--species", "monopodial", "--wind", "winds/w.toml", "--seconds", "1", "--fps", "30"];
+    let (ok, out, err) = sylva(dir.path(), &args);
+    assert!(ok, "{err}");
+    assert!(!out.contains("largest segment-end speed 0.000 m/s"), "{out}");
+    // A grid file that is not there: the wind file's line, the grid and where it was looked for.
+    std::fs::remove_file(dir.path().join("winds/g.swg")).unwrap();
+    let (ok, _, err) = sylva(dir.path(), &args);
+    assert!(!ok);
+    assert!(err.contains("winds/w.toml:3: field[0].file: g.swg") && err.contains("looked for winds/g.swg"), "{err}");
+}

@@ -170,10 +170,12 @@ fn scene_fields_refuse_bad_values_clearly() {
 
 #[test]
 fn wind_fields_refuse_bad_values_clearly() {
-    for name in ["gusty", "blast"] {
+    for name in ["gusty", "blast", "eddies"] {
         let text = preset(&format!("presets/wind/{name}.toml"));
-        let (tried, refused) =
-            check_file(name, &text, &|t| WindScene::from_toml(t, "case.toml").map(|_| ()).map_err(|e| e.to_string()));
+        // Beside the presets, so that the eddies' grid file is found.
+        let (tried, refused) = check_file(name, &text, &|t| {
+            WindScene::from_toml(t, "presets/wind/case.toml").map(|_| ()).map_err(|e| e.to_string())
+        });
         println!("wind {name}: {tried} bad values, {refused} refused");
     }
 }

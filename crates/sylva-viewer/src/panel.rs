@@ -260,6 +260,14 @@ fn wind_fields(ui: &mut egui::Ui, wind: &mut WindScene) -> bool {
                 ui.label("blast");
                 changed |= ui.add(egui::Slider::new(&mut b.strength, 0.0..=100.0).text("strength m/s")).changed();
             }
+            WindField::Grid(g) => {
+                let [nx, ny, nz] = g.data.size;
+                ui.label(format!("grid {} ({nx}×{ny}×{nz}, {} frames)", g.file, g.data.frames));
+                changed |= ui.add(egui::Slider::new(&mut g.scale, 0.0..=5.0).text("strength ×")).changed();
+                changed |= ui.add(egui::Slider::new(&mut g.scroll[0], -20.0..=20.0).text("scroll x m/s")).changed();
+                changed |= ui.add(egui::Slider::new(&mut g.scroll[2], -20.0..=20.0).text("scroll z m/s")).changed();
+                changed |= ui.add(egui::Slider::new(&mut g.frame_rate, 0.0..=30.0).text("frames/s")).changed();
+            }
         });
         ui.separator();
     }

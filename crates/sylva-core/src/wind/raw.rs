@@ -11,6 +11,7 @@
 //! | vortex | centre xz, drift xz | strength, radius, start, duration | fade, updraft, –, – | – |
 //! | blast | centre xyz, strength | start, speed, width, decay | radius, –, –, – | – |
 //! | turbulence | – | fades, as sum of sines | – | `dir` = u · a, `k` = wave vector, `freq` = f, `phase` |
+//! | grid | origin xyz, frames/s | 1/cell xyz, wrap | – | header (`dir` = nx ny nz frames, `k` = scroll), then 3 nodes a record |
 
 use bytemuck::{Pod, Zeroable};
 
@@ -28,6 +29,8 @@ pub mod kind {
     pub const BLAST: u32 = 4;
     /// 1/f^β turbulence by spectral synthesis.
     pub const TURBULENCE: u32 = 5;
+    /// Velocities on a grid (Zioma §6.3.1's wind texture; `wind::grid`).
+    pub const GRID: u32 = 6;
 }
 
 /// One packed field, 64 bytes.

@@ -102,6 +102,7 @@ pub fn field_at(f: &RawField, waves: &[RawWave], p: Vec3, t: f32) -> Vec3 {
             }
             v
         }
+        kind::GRID => crate::wind::grid::grid_at(f, waves, p, t),
         _ => Vec3::ZERO,
     }
 }

@@ -9,6 +9,7 @@ const KIND_GUST_FRONT: u32 = 2u;
 const KIND_VORTEX: u32 = 3u;
 const KIND_BLAST: u32 = 4u;
 const KIND_TURBULENCE: u32 = 5u;
+const KIND_GRID: u32 = 6u;
 
 struct Field {
     kind: u32,
@@ -48,6 +49,85 @@ fn smooth_step(e0: f32, e1: f32, x: f32) -> f32 {
 // A wave field's blend in and out (`wave_envelope` in wind/sample.rs): exactly 1 without fades.
 fn wave_envelope(b: vec4<f32>, t: f32) -> f32 {
     return smooth_step(0.0, 1.0, (t - b.x) * b.y) * (1.0 - smooth_step(0.0, 1.0, (t - b.z) * b.w));
+}
+
+// One axis of a grid lookup (`axis` in wind/grid.rs): the nodes either side of u and the
+// fraction between them, over n nodes repeated (wrap) or held at the edge.
+struct GridAxis {
+    i0: u32,
+    i1: u32,
+    f: f32,
+}
+
+fn grid_axis(u: f32, n: f32, wrap: bool) -> GridAxis {
+    var a: GridAxis;
+    if (wrap) {
+        let fl = floor(u);
+        let m = i32(n);
+        let i = (i32(fl) % m + m) % m;
+        a.i0 = u32(i);
+        a.i1 = u32((i + 1) % m);
+        a.f = u - fl;
+    } else {
+        let c = clamp(u, 0.0, n - 1.0);
+        let fl = floor(c);
+        a.i0 = u32(fl);
+        a.i1 = min(a.i0 + 1u, u32(n) - 1u);
+        a.f = c - fl;
+    }
+    return a;
+}
+
+// Node i of a grid whose nodes start at record `base`, three to a record.
+fn grid_node(base: u32, i: u32) -> vec3<f32> {
+    let w = wind_waves[base + i / 3u];
+    switch i % 3u {
+        case 0u: {
+            return w.dir.xyz;
+        }
+        case 1u: {
+            return w.k.xyz;
+        }
+        default: {
+            return w.phase.xyz;
+        }
+    }
+}
+
+fn grid_lerp(a: vec3<f32>, b: vec3<f32>, s: f32) -> vec3<f32> {
+    return a + (b - a) * s;
+}
+
+fn grid_row(base: u32, at: u32, ax: GridAxis) -> vec3<f32> {
+    return grid_lerp(grid_node(base, at + ax.i0), grid_node(base, at + ax.i1), ax.f);
+}
+
+fn grid_frame(base: u32, k: u32, n: vec3<u32>, ax: GridAxis, ay: GridAxis, az: GridAxis) -> vec3<f32> {
+    let p0 = grid_lerp(
+        grid_row(base, ((k * n.z + az.i0) * n.y + ay.i0) * n.x, ax),
+        grid_row(base, ((k * n.z + az.i0) * n.y + ay.i1) * n.x, ax),
+        ay.f,
+    );
+    let p1 = grid_lerp(
+        grid_row(base, ((k * n.z + az.i1) * n.y + ay.i0) * n.x, ax),
+        grid_row(base, ((k * n.z + az.i1) * n.y + ay.i1) * n.x, ax),
+        ay.f,
+    );
+    return grid_lerp(p0, p1, az.f);
+}
+
+// A grid field (`grid_at` in wind/grid.rs): trilinear in space, linear between looped frames.
+fn grid_at(f: Field, p: vec3<f32>, t: f32) -> vec3<f32> {
+    let head = wind_waves[f.wave_offset];
+    let wrap = f.b.w >= 0.5;
+    let g = ((p - f.a.xyz) - head.k.xyz * t) * f.b.xyz;
+    let ax = grid_axis(g.x, head.dir.x, wrap);
+    let ay = grid_axis(g.y, head.dir.y, wrap);
+    let az = grid_axis(g.z, head.dir.z, wrap);
+    let at = grid_axis(t * f.a.w, head.dir.w, true);
+    let n = vec3<u32>(head.dir.xyz);
+    let base = f.wave_offset + 1u;
+    return grid_lerp(grid_frame(base, at.i0, n, ax, ay, az), grid_frame(base, at.i1, n, ax, ay, az), at.f);
 }
 
 fn field_at(f: Field, p: vec3<f32>, t: f32) -> vec3<f32> {
@@ -138,6 +218,9 @@ fn field_at(f: Field, p: vec3<f32>, t: f32) -> vec3<f32> {
                 v += w.dir.xyz * (sin_turns(th) * e);
             }
             return v;
+        }
+        case KIND_GRID: {
+            return grid_at(f, p, t);
         }
         default: {
             return vec3<f32>(0.0);
