@@ -500,3 +500,49 @@ fn bad_inputs_are_refused_by_name_and_leave_no_file() {
     assert!(matches!(build_gltf(&other, Some(&c), &GltfOptions::default()), Err(GltfError::ClipMismatch { .. })));
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "nothing left behind");
 }
+
+/// The leaf material's texture follows the tree's leaf shape (Weber–Penn `LeafShape`): read
+/// back from the file, its alpha is the outline `LeafShape::contains` draws, it clamps to its
+/// clear border, and the leaves' texture coordinates stay within a few hundredths of it.
+#[test]
+fn the_leaf_texture_follows_the_tree_s_leaf_shape() {
+    use sylva_core::model::LeafShape;
+    let base = tree("quaking_aspen");
+    let mut coverage = Vec::new();
+    for shape in [LeafShape::Disc, LeafShape::Star, LeafShape::Needle] {
+        let t = Tree { leaf_shape: shape, ..base.clone() };
+        let bytes = glb(&t, None, &GltfOptions::default());
+        let g = gltf::Gltf::from_slice(&bytes).unwrap();
+        let blob = g.blob.clone().unwrap();
+        let leaf = g.materials().find(|m| m.name().is_some_and(|n| n.contains("leaf"))).expect("a leaf material");
+        let info = leaf.pbr_metallic_roughness().base_color_texture().expect("a leaf texture");
+        let tex = info.texture();
+        assert_eq!(tex.sampler().wrap_s(), gltf::texture::WrappingMode::ClampToEdge);
+        let gltf::image::Source::View { view, .. } = tex.source().source() else { panic!("embedded") };
+        let png = &blob[view.offset()..view.offset() + view.length()];
+        let img = image::load_from_memory(png).unwrap().to_rgba8();
+        let n = img.width() as f32;
+        let (mut agree, mut total, mut opaque) = (0usize, 0usize, 0usize);
+        for (x, y, p) in img.enumerate_pixels() {
+            let (u, v) = ((x as f32 + 0.5) / n, (y as f32 + 0.5) / n);
+            let inside = shape.contains(u, v);
+            let near = [(-1.5, 0.0), (1.5, 0.0), (0.0, -1.5), (0.0, 1.5)]
+                .iter()
+                .any(|(du, dv)| shape.contains(u + du / n, v + dv / n) != inside);
+            opaque += (p[3] > 127) as usize;
+            if !near && x > 0 && y > 0 && x + 1 < img.width() && y + 1 < img.height() {
+                total += 1;
+                agree += ((p[3] == 255) == inside) as usize;
+            }
+        }
+        assert_eq!(agree, total, "{}: the exported alpha is not the outline", shape.name());
+        coverage.push(opaque);
+        // The leaves' TEXCOORD_0 reach at most 0.15 past the square.
+        let leaf_prim = g.meshes().next().unwrap().primitives().find(|p| p.material().index() == leaf.index()).unwrap();
+        let buf = |b: gltf::Buffer<'_>| -> Option<&[u8]> { (b.index() == 0).then_some(&blob[..]) };
+        let uvs: Vec<[f32; 2]> = leaf_prim.reader(buf).read_tex_coords(0).unwrap().into_f32().collect();
+        assert!(uvs.iter().flatten().all(|c| (-0.15..=1.15).contains(c)), "{}", shape.name());
+    }
+    // Distinct textures: the disc, the star and the needle cover different areas.
+    assert!(coverage[0] != coverage[1] && coverage[2] * 4 < coverage[0], "{coverage:?}");
+}

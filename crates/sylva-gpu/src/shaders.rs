@@ -80,6 +80,8 @@ pub const MESH_TUBES: &str = include_str!("mesh/mesh_tubes.wgsl");
 /// Kernel: midpoint vertices of subdivided bark bands (§2.3).
 pub const MESH_DETAIL: &str = include_str!("mesh/mesh_detail.wgsl");
 /// Kernel: leaf-polygon vertices.
+/// Leaf outlines: `leaf_radius`, `leaf_rim`, `inside_leaf_shape` (twin of `sylva_core::model::leaf_shape`).
+pub const LEAF_SHAPE: &str = include_str!("wgsl/leaf_shape.wgsl");
 pub const MESH_LEAVES: &str = include_str!("mesh/mesh_leaves.wgsl");
 /// Kernel: two-bone skinning of a rest mesh, instance-major.
 pub const SKIN_VERTICES: &str = include_str!("mesh/skin_vertices.wgsl");
@@ -133,7 +135,7 @@ kernels! {
     hsm_pose: [QUAT, TREE, HSM, HSM_POSE] => sylva_core::methods::hsm::kernels::hsm_pose;
     mesh_tubes: [QUAT, TREE, NOISE, MESH, MESH_TUBES] => sylva_core::mesh::mesh_tubes;
     mesh_detail: [NOISE, MESH, MESH_DETAIL] => sylva_core::mesh::mesh_detail;
-    mesh_leaves: [QUAT, TREE, NOISE, MESH, MESH_LEAVES] => sylva_core::mesh::mesh_leaves;
+    mesh_leaves: [QUAT, TREE, NOISE, MESH, LEAF_SHAPE, MESH_LEAVES] => sylva_core::mesh::mesh_leaves;
     skin_vertices: [QUAT, NOISE, MESH, SKIN_VERTICES] => sylva_core::mesh::skin_vertices;
     skjermo_deform: [QUAT, TREE, NOISE, MESH, SKJERMO, SKJERMO_DEFORM] => sylva_core::mesh::skjermo_deform;
 }

@@ -70,6 +70,32 @@ fn gpu_mesh_matches_cpu_on_every_preset_and_random_poses() {
     }
 }
 
+/// Every leaf outline (`leaf_rim` in `leaf_shape.wgsl` and its CPU twin), on random poses
+/// and polygon sizes, within the same bounds.
+#[test]
+fn every_leaf_shape_meshes_alike_on_cpu_and_gpu() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(2027);
+    let base = SpeciesSource::resolve("sassafras").unwrap().generate(3, &Default::default(), None).unwrap();
+    for shape in sylva_core::model::LeafShape::ALL {
+        let t = Tree { leaf_shape: shape, ..base.clone() };
+        let params = MeshParams { leaf_sides: rng.random_range(3..24), ..Default::default() };
+        let layout = MeshLayout::new(&t, params).unwrap();
+        let gpu = GpuMesh::new(ctx, &layout).unwrap();
+        let pose = random_pose(&t, &mut rng);
+        let cpu = layout.mesh(&t, &pose);
+        let worst = compare(&t, &cpu, &gpu.mesh(ctx, &t, &pose).unwrap(), shape.name());
+        // The outline reaches the rim: the polar shapes' rims differ from the disc's ellipse.
+        let rim = |m: &MeshFrame| m.leaves.iter().map(|v| (v.u - 0.5).abs()).fold(0.0f32, f32::max);
+        println!(
+            "leaf shape {:<6} ({} sides): widest rim {:.3}, worst {worst:.1e} × height",
+            shape.name(),
+            params.leaf_sides,
+            rim(&cpu)
+        );
+    }
+}
+
 #[test]
 fn gpu_mesh_reads_a_gpu_methods_pose_without_a_round_trip() {
     let Some(ctx) = common::gpu() else { return };

@@ -84,8 +84,8 @@ fn small_scene_matches_its_golden_image() {
     let instances = Renderer::instances(
         ctx,
         &[
-            Instance { transform: Mat4::IDENTITY, tint },
-            Instance { transform: Mat4::from_translation(Vec3::new(-4.0, 0.0, -5.0)), tint },
+            Instance { transform: Mat4::IDENTITY, tint, leaf_shape: t.leaf_shape },
+            Instance { transform: Mat4::from_translation(Vec3::new(-4.0, 0.0, -5.0)), tint, leaf_shape: t.leaf_shape },
         ],
     );
     let globals = renderer.globals(&camera, &light, (Vec3::new(-6.0, 0.0, -7.0), Vec3::new(3.0, 5.0, 3.0)));
@@ -124,7 +124,11 @@ fn skinned_instances_drawn_in_batches_match_one_batch() {
     let camera = Camera { eye: Vec3::new(0.0, 3.0, 14.0), target: Vec3::new(0.0, 2.5, 0.0), fov_y_deg: 45.0 };
     let tint = Vec3::new(0.25, 0.5, 0.1);
     let placed: Vec<Instance> = (0..3)
-        .map(|k| Instance { transform: Mat4::from_translation(Vec3::new(-5.0 + 5.0 * k as f32, 0.0, 0.0)), tint })
+        .map(|k| Instance {
+            transform: Mat4::from_translation(Vec3::new(-5.0 + 5.0 * k as f32, 0.0, 0.0)),
+            tint,
+            leaf_shape: t.leaf_shape,
+        })
         .collect();
     let instances = Renderer::instances(ctx, &placed);
     let globals =
@@ -155,4 +159,84 @@ fn skinned_instances_drawn_in_batches_match_one_batch() {
     assert!(trees > (w * h / 50) as usize, "only {trees} pixels show trees");
     let differ = images[0].chunks(4).zip(images[1].chunks(4)).filter(|(a, b)| a[..3] != b[..3]).count();
     assert_eq!(differ, 0, "{differ} pixels differ between one batch and three");
+}
+
+/// The renderer cuts each leaf to the outline its shape names, as the CPU twin
+/// (`LeafShape::contains`, which the exported texture's alpha follows): one 2 m leaf per
+/// shape, facing a distant camera, compared pixel by pixel away from the outline's edge.
+#[test]
+fn the_renderer_cuts_every_leaf_shape_as_the_cpu_outline() {
+    use glam::{DQuat, DVec3};
+    use sylva_core::model::{LeafDraft, LeafShape, TreeBuilder, WoodProperties};
+    let Some(ctx) = common::gpu() else { return };
+    let (w, h) = (96u32, 96u32);
+    let renderer = Renderer::new(ctx, RenderSettings { width: w, height: h, msaa: 1, shadow_size: 256 }).unwrap();
+    // The leaf's square spans x ∈ [−1, 1], y ∈ [50, 52] at z = 0; the view 2.6 m across.
+    let half = 1.3f32;
+    let camera = Camera {
+        eye: Vec3::new(0.0, 51.0, 200.0),
+        target: Vec3::new(0.0, 51.0, 0.0),
+        fov_y_deg: (2.0 * (half / 200.0).atan()).to_degrees(),
+    };
+    let globals =
+        renderer.globals(&camera, &Lighting::default(), (Vec3::new(-1.0, 50.0, -1.0), Vec3::new(1.0, 52.0, 1.0)));
+    let empty = renderer.render(ctx, &globals, &[]).unwrap();
+    for shape in LeafShape::ALL {
+        let mut b = TreeBuilder::default();
+        let stem = b.add_stem(None, 0);
+        let base = DVec3::new(0.0, 50.0, 0.0);
+        b.push_segment(stem, base, base + DVec3::Y * 0.01, DQuat::IDENTITY, 0.001, 0.001);
+        b.leaves.push(LeafDraft {
+            stem,
+            segment: 0,
+            position: base,
+            orientation: DQuat::IDENTITY,
+            width: 2.0,
+            length: 2.0,
+        });
+        let mut t = b.build("leaf", 1, WoodProperties::default()).unwrap();
+        t.leaf_shape = shape;
+        let layout = MeshLayout::new(&t, MeshParams { leaf_sides: 16, ..Default::default() }).unwrap();
+        let mesh = GpuMesh::new(ctx, &layout).unwrap();
+        let instances = Renderer::instances(
+            ctx,
+            &[Instance { transform: Mat4::IDENTITY, tint: Vec3::new(0.3, 0.5, 0.1), leaf_shape: shape }],
+        );
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        mesh.record_pose(ctx, &mut encoder, &t, &Pose::rest(&t));
+        renderer.record(ctx, &mut encoder, &globals, &[mesh.draw_item(&instances, 1)]);
+        let rgba = renderer.read_image(ctx, encoder).unwrap();
+        // Pixel centre → (u, v) on the leaf's square.
+        let uv = |x: f32, y: f32| {
+            let wx = (x - w as f32 / 2.0) / (h as f32 / 2.0) * half;
+            let wy = 51.0 - (y - h as f32 / 2.0) / (h as f32 / 2.0) * half;
+            (wx / 2.0 + 0.5, (wy - 50.0) / 2.0)
+        };
+        let (mut checked, mut wrong, mut blade) = (0, 0, 0);
+        for y in 0..h {
+            for x in 0..w {
+                let (u, v) = uv(x as f32 + 0.5, y as f32 + 0.5);
+                let inside = shape.contains(u, v);
+                // Away from the edge (1.5 pixels) and from the stub of stem at the base.
+                let p = 1.5 * 2.0 * half / h as f32 / 2.0;
+                let near = [(-p, 0.0), (p, 0.0), (0.0, -p), (0.0, p)]
+                    .iter()
+                    .any(|(du, dv)| shape.contains(u + du, v + dv) != inside);
+                if near || ((u - 0.5).abs() < 0.05 && v.abs() < 0.05) {
+                    continue;
+                }
+                let i = ((y * w + x) * 4) as usize;
+                let drawn = rgba[i..i + 3] != empty[i..i + 3];
+                checked += 1;
+                blade += inside as usize;
+                wrong += (drawn != inside) as usize;
+            }
+        }
+        println!("{:<6}: {blade} blade pixels, {wrong} of {checked} disagree", shape.name());
+        assert!(
+            blade > 100 && wrong == 0,
+            "{}: {wrong} of {checked} pixels disagree with the CPU outline",
+            shape.name()
+        );
+    }
 }

@@ -15,6 +15,7 @@ use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::mesh::{DeformLayout, DeformerParams, MeshLayout, MeshParams, RawVertex, SkinLayout};
 use sylva_core::methods::{Animator, MethodOptions};
+use sylva_core::model::LeafShape;
 use sylva_core::pose::{Placement, Pose, SeamPose};
 use sylva_core::scene::{BackendChoice, Scene, SceneTree};
 use sylva_core::species::SpeciesSource;
@@ -226,7 +227,7 @@ pub struct WorldTree {
     pub simulations: usize,
 }
 
-fn instance(position: [f32; 3], yaw_deg: f32, scale: f32, tint: Vec3) -> Instance {
+fn instance(position: [f32; 3], yaw_deg: f32, scale: f32, tint: Vec3, leaf_shape: LeafShape) -> Instance {
     Instance {
         transform: Mat4::from_scale_rotation_translation(
             Vec3::splat(scale),
@@ -234,6 +235,7 @@ fn instance(position: [f32; 3], yaw_deg: f32, scale: f32, tint: Vec3) -> Instanc
             Vec3::from_array(position),
         ),
         tint,
+        leaf_shape,
     }
 }
 
@@ -322,8 +324,9 @@ impl WorldTree {
         };
         let layout = MeshLayout::new(&tree, params)?;
         let tint = Vec3::from_array(st.tint.unwrap_or([0.28, 0.50, 0.12]));
-        let mut inst = vec![instance(st.position, st.yaw_deg, st.scale, tint)];
-        inst.extend(st.copies.iter().map(|c| instance(c.position, c.yaw_deg, c.scale, tint * 1.05)));
+        let shape = tree.leaf_shape;
+        let mut inst = vec![instance(st.position, st.yaw_deg, st.scale, tint, shape)];
+        inst.extend(st.copies.iter().map(|c| instance(c.position, c.yaw_deg, c.scale, tint * 1.05, shape)));
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         let (tlo, thi) = tree.bounds();
         for i in &inst {

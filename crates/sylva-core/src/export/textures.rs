@@ -1,13 +1,14 @@
 //! Procedural textures shipped inside exported files: a tileable bark colour map and a
-//! leaf colour map whose alpha cuts the blade's outline. Deterministic (the same bytes
+//! leaf colour map whose alpha cuts the blade's outline (the tree's leaf shape). Deterministic (the same bytes
 //! every run), so exported files are reproducible.
 //!
 //! Coordinates follow the meshes: bark `u` runs once around the stem and `v` along it (both
 //! repeat); a leaf's `u` runs across the blade (0.5 the midrib) and `v` from the base
 //! (image row 0) to the tip (the last row).
 
+use crate::model::LeafShape;
 use crate::wind::noise::hash_unit;
-use std::f32::consts::{PI, TAU};
+use std::f32::consts::TAU;
 
 /// Side of each texture, pixels.
 pub const TEXTURE_SIZE: u32 = 256;
@@ -75,17 +76,28 @@ pub fn bark_normal_png() -> Vec<u8> {
     )
 }
 
-/// Leaf normal map: the midrib and veins raised.
-pub fn leaf_normal_png() -> Vec<u8> {
-    normal_map(|u, v| leaf_veins(u, v).0, 12.0)
+/// Leaf normal map of a shape: the midrib and veins raised.
+pub fn leaf_normal_png(shape: LeafShape) -> Vec<u8> {
+    normal_map(|u, v| leaf_veins(shape, u, v).0, 12.0)
+}
+
+/// How far (u, v) lies inside the blade's edge, in (u, v) units (negative outside), and the
+/// blade's half-width there for the veins to fade across.
+fn blade_edge(shape: LeafShape, u: f32, v: f32) -> (f32, f32) {
+    if shape == LeafShape::Disc {
+        let half = leaf_half_width(v);
+        return (half - (u - 0.5).abs(), half);
+    }
+    let (x, y) = (u - 0.5, v - 0.5);
+    ((shape.radius(x.atan2(y)) - (x * x + y * y).sqrt()), 0.5)
 }
 
 /// Midrib + veins (0…1) and the blade's coverage (0…1) at (u, v).
-fn leaf_veins(u: f32, v: f32) -> (f32, f32) {
+fn leaf_veins(shape: LeafShape, u: f32, v: f32) -> (f32, f32) {
     let n = TEXTURE_SIZE as f32;
     let across = (u - 0.5).abs();
-    let half = leaf_half_width(v);
-    let edge = ((half - across) * n + 0.5).clamp(0.0, 1.0);
+    let (inside, half) = blade_edge(shape, u, v);
+    let edge = (inside * n + 0.5).clamp(0.0, 1.0);
     let midrib = (1.0 - across * n / 2.5).max(0.0);
     // Veins leave the midrib toward the tip at about 45°.
     let s = (v - across * 0.9) * 9.0;
@@ -112,24 +124,24 @@ pub fn bark_png() -> Vec<u8> {
     encode_png(&px, image::ExtendedColorType::Rgb8)
 }
 
-/// Half-width of the leaf outline at `v` (0 base … 1 tip), in texture units: rounded at
+/// Half-width of the disc's outline at `v` (0 base … 1 tip), in texture units: rounded at
 /// the base, pointed at the tip, never wider than the mesh's ellipse.
 pub fn leaf_half_width(v: f32) -> f32 {
-    if !(0.0..=1.0).contains(&v) {
-        return 0.0;
-    }
-    0.46 * (PI * v.powf(0.75)).sin().max(0.0).powf(0.9) * (1.0 - v).powf(0.15)
+    crate::model::leaf_shape::disc_half_width(v)
 }
 
 /// Leaf: green blade with a lighter midrib and veins, alpha 255 inside the outline and 0
-/// outside (a one-pixel soft edge); RGBA PNG.
-pub fn leaf_png() -> Vec<u8> {
+/// outside the shape's outline (a one-pixel soft edge); RGBA PNG.
+pub fn leaf_png(shape: LeafShape) -> Vec<u8> {
     let n = TEXTURE_SIZE;
     let mut px = Vec::with_capacity((n * n * 4) as usize);
     for y in 0..n {
         for x in 0..n {
             let (u, v) = ((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
-            let (light, edge) = leaf_veins(u, v);
+            let (light, edge) = leaf_veins(shape, u, v);
+            // A clear border: the leaf polygon reaches just past the square, and a sampler
+            // that clamps to the edge shows nothing there.
+            let edge = if x == 0 || y == 0 || x == n - 1 || y == n - 1 { 0.0 } else { edge };
             let shade = 0.85 + 0.15 * tiled_noise(u, v, 16, 71);
             let rgb = [(0.16 + 0.20 * light) * shade, (0.38 + 0.25 * light) * shade, (0.08 + 0.12 * light) * shade];
             px.extend(rgb.iter().map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8));

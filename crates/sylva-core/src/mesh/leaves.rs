@@ -2,7 +2,8 @@
 //! §2.4). See [`crate::mesh`] for the construction.
 
 use crate::mesh::{RawMeshInfo, RawVertex};
-use crate::model::{RawLeaf, RawSegment};
+use crate::model::leaf_shape::leaf_rim;
+use crate::model::{LeafShape, RawLeaf, RawSegment};
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
@@ -18,11 +19,10 @@ pub fn mesh_leaves(
     vertex: &mut [RawVertex],
 ) {
     let stride = info.leaf_sides as usize + 1;
-    let unit: Vec<(f32, f32)> = (0..info.leaf_sides)
-        .map(|k| {
-            let a = std::f32::consts::TAU * k as f32 / info.leaf_sides as f32;
-            (a.sin(), a.cos())
-        })
+    // Each shape's rim once (the disc's two half-circles, or a polygon holding the outline).
+    // One past the last shape: what an unknown index gets on both sides (the default radius).
+    let rims: Vec<Vec<(f32, f32)>> = (0..=LeafShape::ALL.len() as u32)
+        .map(|shape| (0..info.leaf_sides).map(|k| leaf_rim(shape, k, info.leaf_sides)).collect())
         .collect();
     vertex.par_chunks_mut(stride).zip(leaf.par_iter()).for_each(|(out, lf)| {
         let s = lf.segment as usize;
@@ -32,14 +32,11 @@ pub fn mesh_leaves(
         let q = d * Quat::from_array(lf.orientation);
         let (qx, qy) = (q * Vec3::X, q * Vec3::Y);
         let normal = (q * Vec3::Z).to_array();
+        let rim = &rims[(lf.shape as usize).min(rims.len() - 1)];
         for (k, v) in out.iter_mut().enumerate() {
-            // (u, v) on the blade: the centre, then two half-circles of the unit n-gon from
-            // the base (a = 0) to the tip (a = π), scaled to width and length.
-            let mut uv = (0.5, 0.5);
-            if k > 0 {
-                let (sin, cos) = unit[k - 1];
-                uv = (0.5 * sin + 0.5, 0.5 - 0.5 * cos);
-            }
+            // (u, v) on the blade: the centre, then the rim from the base through +u to the
+            // tip and back, scaled to width and length.
+            let uv = if k > 0 { rim[k - 1] } else { (0.5, 0.5) };
             let p = base + qx * ((uv.0 - 0.5) * lf.width) + qy * (uv.1 * lf.length);
             *v = RawVertex { position: p.to_array(), u: uv.0, normal, v: uv.1 };
         }

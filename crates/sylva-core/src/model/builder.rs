@@ -309,6 +309,7 @@ impl TreeBuilder {
             children,
             wood,
             trunk_shape: Default::default(),
+            leaf_shape: Default::default(),
         };
         tree.validate()?;
         Ok(tree)

@@ -15,11 +15,13 @@
 mod bezier;
 mod builder;
 mod digest;
+pub mod leaf_shape;
 mod raw;
 mod validate;
 
 pub use bezier::{CubicBezier, fit_cubic_bezier};
 pub use builder::{LeafDraft, SegmentDraft, StemDraft, TreeBuilder};
+pub use leaf_shape::LeafShape;
 pub use raw::{RawLeaf, RawSegment, RawStem};
 pub use validate::ModelError;
 
@@ -224,6 +226,8 @@ pub struct Tree {
     /// The trunk's cross-section as the species describes it (flare, lobes, bulges): what
     /// the segment radii already hold (flare) and what only a mesher adds (lobes, bulges).
     pub trunk_shape: TrunkShape,
+    /// The outline of every leaf (Weber–Penn `LeafShape`).
+    pub leaf_shape: LeafShape,
 }
 
 /// The trunk's shape beyond its segments' radii (Weber–Penn `Flare`, `Lobes`, `LobeDepth`;

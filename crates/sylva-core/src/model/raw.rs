@@ -125,8 +125,10 @@ pub struct RawLeaf {
     pub length: f32,
     /// Segment it hangs on.
     pub segment: u32,
+    /// Outline, a [`crate::model::LeafShape`] index.
+    pub shape: u32,
     /// Padding.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
 }
 
 impl RawLeaf {
@@ -138,7 +140,8 @@ impl RawLeaf {
             orientation: l.orientation[i].to_array(),
             length: l.length[i],
             segment: l.segment[i],
-            _pad: [0; 2],
+            shape: t.leaf_shape.index(),
+            _pad: 0,
         }
     }
 }

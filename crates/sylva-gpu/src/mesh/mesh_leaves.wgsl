@@ -1,6 +1,6 @@
 // mesh_leaves: one leaf per invocation (Akagi §2.4): the leaf's transform once, then its
-// polygon — k = 0 the centre, 1.. the rim, two half-circles of the unit n-gon scaled to the
-// blade.
+// polygon — k = 0 the centre, 1.. the rim (leaf_rim: the disc's two half-circles, or a
+// polygon holding the leaf's outline), scaled to the blade.
 // CPU twin: sylva_core::mesh::mesh_leaves (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> info: MeshInfo;
@@ -28,8 +28,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     for (var k = 0u; k < stride; k++) {
         var uv = vec2<f32>(0.5, 0.5);
         if (k > 0u) {
-            let a = TAU * f32(k - 1u) / f32(info.leaf_sides);
-            uv = vec2<f32>(0.5 * sin(a) + 0.5, 0.5 - 0.5 * cos(a));
+            uv = leaf_rim(lf.shape, k - 1u, info.leaf_sides);
         }
         let p = base + qx * ((uv.x - 0.5) * lf.width) + qy * (uv.y * lf.length);
         vertex[l * stride + k] = Vertex(p, uv.x, normal, uv.y);

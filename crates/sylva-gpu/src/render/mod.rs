@@ -14,7 +14,7 @@ use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
 /// The renderer's WGSL (validated by naga in the tests).
-pub const RENDER_WGSL: &str = include_str!("render.wgsl");
+pub const RENDER_WGSL: &str = concat!(include_str!("../wgsl/leaf_shape.wgsl"), include_str!("render.wgsl"));
 
 const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -104,6 +104,8 @@ pub struct Instance {
     pub transform: Mat4,
     /// Leaf colour (linear); bark takes a hint of it.
     pub tint: Vec3,
+    /// The outline the leaves are cut to (the tree's [`sylva_core::model::LeafShape`]).
+    pub leaf_shape: sylva_core::model::LeafShape,
 }
 
 /// GPU twin of [`Instance`], 80 bytes: four matrix columns and the tint (vertex attributes
@@ -113,7 +115,7 @@ pub struct Instance {
 pub struct RawInstance {
     /// Matrix columns.
     pub model: [[f32; 4]; 4],
-    /// Tint (rgb, 1).
+    /// Tint (rgb) and the leaf shape's index (w).
     pub tint: [f32; 4],
 }
 
@@ -484,7 +486,10 @@ impl Renderer {
     pub fn instances(ctx: &GpuContext, instances: &[Instance]) -> wgpu::Buffer {
         let raw: Vec<RawInstance> = instances
             .iter()
-            .map(|i| RawInstance { model: i.transform.to_cols_array_2d(), tint: i.tint.extend(1.0).to_array() })
+            .map(|i| RawInstance {
+                model: i.transform.to_cols_array_2d(),
+                tint: i.tint.extend(i.leaf_shape.index() as f32).to_array(),
+            })
             .collect();
         let raw = if raw.is_empty() { vec![RawInstance::zeroed()] } else { raw };
         ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

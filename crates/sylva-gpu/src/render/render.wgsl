@@ -176,18 +176,16 @@ fn fs_bark(v: TreeOut) -> @location(0) vec4<f32> {
     return vec4<f32>(fog(c, v.world), 1.0);
 }
 
-// The blade's outline inside the leaf polygon's ellipse: rounded at the base, pointed at
-// the tip (u across, 0.5 the midrib; v from base 0 to tip 1). The same outline cuts the
-// exported leaf texture's alpha (CPU twin: sylva_core::export::textures::leaf_half_width).
-fn inside_leaf(uv: vec2<f32>) -> bool {
-    let v = clamp(uv.y, 0.0, 1.0);
-    let half = 0.46 * pow(max(sin(3.14159265 * pow(max(v, 1e-6), 0.75)), 1e-6), 0.9) * pow(max(1.0 - v, 1e-6), 0.15);
-    return abs(uv.x - 0.5) <= half;
+// The blade's outline (leaf_shape.wgsl, composed before this file): the instance's leaf
+// shape rides in its tint's w. The same outline cuts the exported leaf texture's alpha
+// (CPU twin: sylva_core::model::LeafShape::contains).
+fn inside_leaf(shape: f32, uv: vec2<f32>) -> bool {
+    return inside_leaf_shape(u32(shape + 0.5), uv);
 }
 
 @fragment
 fn fs_leaf(v: TreeOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
-    if (!inside_leaf(v.uv)) {
+    if (!inside_leaf(v.tint.w, v.uv)) {
         discard;
     }
     var n = normalize(v.normal);
@@ -214,19 +212,20 @@ fn vs_shadow(v: VertexIn) -> @builtin(position) vec4<f32> {
 struct ShadowLeafOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,
+    @location(1) shape: f32,
 }
 
 @vertex
 fn vs_shadow_leaf(v: VertexIn) -> ShadowLeafOut {
     let model = mat4x4<f32>(v.m0, v.m1, v.m2, v.m3);
     let clip = g.sun_view_proj * (model * vec4<f32>(v.position_u.xyz, 1.0));
-    return ShadowLeafOut(clip, vec2<f32>(v.position_u.w, v.normal_v.w));
+    return ShadowLeafOut(clip, vec2<f32>(v.position_u.w, v.normal_v.w), v.tint.w);
 }
 
 // Leaves cast the shadow of their outline, not of the polygon around it.
 @fragment
 fn fs_shadow_leaf(v: ShadowLeafOut) {
-    if (!inside_leaf(v.uv)) {
+    if (!inside_leaf(v.shape, v.uv)) {
         discard;
     }
 }

@@ -39,5 +39,6 @@ struct Leaf {
     orientation: vec4<f32>,
     length: f32,
     segment: u32,
-    _pad: vec2<u32>,
+    shape: u32,
+    _pad: u32,
 }

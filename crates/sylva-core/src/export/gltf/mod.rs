@@ -284,10 +284,18 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         wrap_t: Valid(json::texture::WrappingMode::Repeat),
         ..Default::default()
     });
+    // Leaves clamp to the texture's clear border: their polygons reach just past the square.
+    let leaf_sampler = b.root.push(json::texture::Sampler {
+        mag_filter: Some(Valid(json::texture::MagFilter::Linear)),
+        min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
+        wrap_s: Valid(json::texture::WrappingMode::ClampToEdge),
+        wrap_t: Valid(json::texture::WrappingMode::ClampToEdge),
+        ..Default::default()
+    });
     let bark_tex = b.texture("bark", &textures::bark_png(), sampler);
-    let leaf_tex = b.texture("leaf", &textures::leaf_png(), sampler);
+    let leaf_tex = b.texture("leaf", &textures::leaf_png(tree.leaf_shape), leaf_sampler);
     let bark_normal = b.texture("bark_normal", &textures::bark_normal_png(), sampler);
-    let leaf_normal = b.texture("leaf_normal", &textures::leaf_normal_png(), sampler);
+    let leaf_normal = b.texture("leaf_normal", &textures::leaf_normal_png(tree.leaf_shape), leaf_sampler);
     let texture_bytes = b.bin.len() - before;
     let material = |name: &str, tex, normal, roughness: f32, leaf: bool| json::Material {
         name: Some(name.into()),

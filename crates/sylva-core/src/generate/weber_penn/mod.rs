@@ -519,6 +519,7 @@ impl WeberPennParams {
             bulges: p.bulges as f32,
             bulge_depth: p.bulge_depth as f32,
         };
+        tree.leaf_shape = p.leaf_shape;
         Ok(tree)
     }
 }

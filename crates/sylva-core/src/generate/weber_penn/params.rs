@@ -6,26 +6,7 @@
 use crate::model::WoodProperties;
 use serde::{Deserialize, Serialize};
 
-/// Leaf shape names (Arbaro's set); the shape matters to meshing, not to the skeleton.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum LeafShape {
-    /// Ellipse (Weber–Penn LeafShape 0).
-    #[default]
-    Disc,
-    /// Rounded triangle.
-    Disc1,
-    /// Narrow ellipse.
-    Disc2,
-    /// Wide ellipse.
-    Disc3,
-    /// Rectangle.
-    Square,
-    /// Long thin blade (palm fronds).
-    Palm,
-    /// Conifer needle.
-    Needle,
-}
+pub use crate::model::LeafShape;
 
 /// Parameters of one level (`n` in the paper's `nLength`, …); level 0 is the trunk.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -161,7 +142,7 @@ pub struct WeberPennParams {
     /// Leaves per last-level stem; negative = a fan of leaves at each stem tip.
     #[serde(default)]
     pub leaves: f64,
-    /// LeafShape.
+    /// LeafShape: the leaves' outline, a name or its index 0–8 (`model::leaf_shape`).
     #[serde(default)]
     pub leaf_shape: LeafShape,
     /// LeafScale: leaf length, m.
