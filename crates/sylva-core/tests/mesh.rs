@@ -155,8 +155,13 @@ fn leaves_hang_where_their_points_are_and_move_with_their_segment() {
         let c = pos(&rest.leaves[i * stride]);
         let want = t.leaves.position[i] + t.leaves.orientation[i] * Vec3::new(0.0, 0.5 * t.leaves.length[i], 0.0);
         assert!((c - want).length() < 1e-5, "leaf {i} centre");
-        // The first rim vertex is the attachment point; the opposite one is the tip.
-        assert!((pos(&rest.leaves[i * stride + 1]) - t.leaves.position[i]).length() < 1e-5);
+        // The first rim vertex lies on the midrib below the centre, where v = 0 is the
+        // attachment point (the disc's half-circles hold its blade, so they start a little
+        // below it).
+        let r = &rest.leaves[i * stride + 1];
+        assert!((r.u - 0.5).abs() < 1e-6 && r.v < 0.0 && r.v > -0.1, "leaf {i} rim start ({}, {})", r.u, r.v);
+        let attach = c + (pos(r) - c) * (0.5 / (0.5 - r.v));
+        assert!((attach - t.leaves.position[i]).length() < 1e-5, "leaf {i} attachment");
         let n = Vec3::from_array(rest.leaves[i * stride].normal);
         assert!((n - t.leaves.orientation[i] * Vec3::Z).length() < 1e-5);
     }

@@ -277,21 +277,19 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
 
     // Materials and textures.
     let before = b.bin.len();
-    let sampler = b.root.push(json::texture::Sampler {
-        mag_filter: Some(Valid(json::texture::MagFilter::Linear)),
-        min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
-        wrap_s: Valid(json::texture::WrappingMode::Repeat),
-        wrap_t: Valid(json::texture::WrappingMode::Repeat),
-        ..Default::default()
-    });
-    // Leaves clamp to the texture's clear border: their polygons reach just past the square.
-    let leaf_sampler = b.root.push(json::texture::Sampler {
-        mag_filter: Some(Valid(json::texture::MagFilter::Linear)),
-        min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
-        wrap_s: Valid(json::texture::WrappingMode::ClampToEdge),
-        wrap_t: Valid(json::texture::WrappingMode::ClampToEdge),
-        ..Default::default()
-    });
+    // Bark repeats; leaves clamp to the texture's clear border (their polygons reach just
+    // past the square).
+    let mut sampler = |wrap: json::texture::WrappingMode| {
+        b.root.push(json::texture::Sampler {
+            mag_filter: Some(Valid(json::texture::MagFilter::Linear)),
+            min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
+            wrap_s: Valid(wrap),
+            wrap_t: Valid(wrap),
+            ..Default::default()
+        })
+    };
+    let (sampler, leaf_sampler) =
+        (sampler(json::texture::WrappingMode::Repeat), sampler(json::texture::WrappingMode::ClampToEdge));
     let bark_tex = b.texture("bark", &textures::bark_png(), sampler);
     let leaf_tex = b.texture("leaf", &textures::leaf_png(tree.leaf_shape), leaf_sampler);
     let bark_normal = b.texture("bark_normal", &textures::bark_normal_png(), sampler);
