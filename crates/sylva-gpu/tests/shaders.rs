@@ -159,6 +159,7 @@ fn pod_structs_match_their_wgsl_twins() {
             ("orientation", offset_of!(RawLeaf, orientation)),
             ("length", offset_of!(RawLeaf, length)),
             ("segment", offset_of!(RawLeaf, segment)),
+            ("shape", offset_of!(RawLeaf, shape)),
             ("_pad", offset_of!(RawLeaf, _pad)),
         ],
     );
