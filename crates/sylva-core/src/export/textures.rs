@@ -7,6 +7,7 @@
 //! (image row 0) to the tip (the last row).
 
 use crate::model::LeafShape;
+use crate::model::leaf_shape::disc_half_width;
 use crate::wind::noise::hash_unit;
 use std::f32::consts::TAU;
 
@@ -85,7 +86,7 @@ pub fn leaf_normal_png(shape: LeafShape) -> Vec<u8> {
 /// blade's half-width there for the veins to fade across.
 fn blade_edge(shape: LeafShape, u: f32, v: f32) -> (f32, f32) {
     if shape == LeafShape::Disc {
-        let half = leaf_half_width(v);
+        let half = disc_half_width(v);
         return (half - (u - 0.5).abs(), half);
     }
     let (x, y) = (u - 0.5, v - 0.5);
@@ -122,12 +123,6 @@ pub fn bark_png() -> Vec<u8> {
         }
     }
     encode_png(&px, image::ExtendedColorType::Rgb8)
-}
-
-/// Half-width of the disc's outline at `v` (0 base … 1 tip), in texture units: rounded at
-/// the base, pointed at the tip, never wider than the mesh's ellipse.
-pub fn leaf_half_width(v: f32) -> f32 {
-    crate::model::leaf_shape::disc_half_width(v)
 }
 
 /// Leaf: green blade with a lighter midrib and veins, alpha 255 inside the outline and 0
