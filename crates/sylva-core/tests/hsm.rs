@@ -209,12 +209,20 @@ fn cantilever() -> Tree {
 
 /// The static sag does not depend on the substep (α = k h² makes the pull a spring of
 /// stiffness k), so it converges as substeps increase; it points down and is not trivial.
+/// Exactly `substeps` substeps, uncalibrated: the scheme itself.
 #[test]
 fn a_cantilever_sags_the_same_whatever_the_substeps() {
     let t = cantilever();
     let mut sags = Vec::new();
     for substeps in [1, 2, 4, 8, 16] {
-        let params = HsmParams { prestressed: false, stiffness_scale: 0.25, substeps, ..Default::default() };
+        let params = HsmParams {
+            prestressed: false,
+            stiffness_scale: 0.25,
+            substeps,
+            substep_rate: 0.0,
+            calibrate: false,
+            ..Default::default()
+        };
         let h = Hsm::new(&t, params).unwrap();
         let alpha_max =
             h.layout.clusters.iter().map(|c| c.rest_cm[3]).fold(0.0, f32::max) / (240.0 * substeps as f32).powi(2);
@@ -307,36 +315,44 @@ fn max_speed(s: &HsmState) -> f32 {
     s.velocity.iter().map(|v| Vec3::new(v[0], v[1], v[2]).length()).fold(0.0, f32::max)
 }
 
-/// Song's central claim on the whole stochastic bush: 100,000 steps of a 40 m/s gusty storm
-/// keep every particle finite and slower than twice the wind, the pose sound; after the
-/// wind stops the bush returns to within 1 % of its height of rest.
+/// Song's central claim, stability, in a hurricane on the whole stochastic bush: ten
+/// simulated minutes (36,000 steps) of 60 m/s wind with the `gusty` preset's turbulence at
+/// 12 m/s keep every particle finite and slower than twice the wind, the pose sound; a
+/// minute after the wind stops the bush is back within 1 % of its height of rest.
 #[test]
-fn a_100_000_step_storm_stays_stable_and_recovers() {
+fn ten_minutes_of_hurricane_stay_stable_and_recover() {
     let t = tree("stochastic_bush");
     let h = Hsm::new(&t, HsmParams::default()).unwrap();
-    let fw = storm(40.0).packed();
+    let mut wind = storm(60.0);
+    for f in &mut wind.fields {
+        if let WindField::Turbulence(tu) = f {
+            (tu.intensity, tu.mean_speed) = (12.0, 60.0);
+        }
+    }
+    let fw = wind.packed();
     let mut s = h.state_at_rest();
     let rest = s.clone();
-    for k in 0..100_000 {
+    for k in 0..36_000 {
         h.step_packed(&fw.fields, &fw.waves, &mut s, 1.0 / 60.0);
-        if k % 5_000 == 0 || k == 99_999 {
+        if k % 3_000 == 0 || k == 35_999 {
             assert!(s.displacement.iter().all(|p| p.iter().all(|v| v.is_finite())), "step {k}: NaN");
             let v = max_speed(&s);
-            assert!(v < 80.0, "step {k}: a particle at {v} m/s");
+            assert!(v < 120.0, "step {k}: a particle at {v} m/s");
             if let Err(e) = h.pose(&t, &PackedWind::calm(), &s).check_sound(&t) {
                 panic!("step {k}: {e}");
             }
         }
     }
-    for _ in 0..1_200 {
+    assert!(s.max_distance(&rest) > 1e-3, "the hurricane moved nothing");
+    for _ in 0..3_600 {
         h.step_packed(&[], &[], &mut s, 1.0 / 60.0);
     }
     let d = s.max_distance(&rest);
-    assert!(d <= 0.01 * t.height(), "20 s after the storm a particle is {d} m from rest");
+    assert!(d <= 0.01 * t.height(), "a minute after the hurricane a particle is {d} m from rest");
 }
 
 /// Every preset (its first 600 clusters, grown from the root): a 1,000-step storm stays
-/// finite and bounded, and 20 s of calm bring it back within 1 % of its height.
+/// finite and bounded, and a minute of calm brings it back within 1 % of its height.
 #[test]
 fn every_preset_survives_a_storm_and_returns_to_rest() {
     let fw = storm(40.0).packed();
@@ -355,7 +371,9 @@ fn every_preset_survives_a_storm_and_returns_to_rest() {
         assert!(s.displacement.iter().all(|p| p.iter().all(|v| v.is_finite())), "{}: NaN", p.name);
         assert!(max_speed(&s) < 80.0, "{}: a particle at {} m/s", p.name, max_speed(&s));
         assert!(peak > 1e-3, "{}: the storm moved nothing", p.name);
-        for _ in 0..1_200 {
+        // A minute of calm: the structural damping alone (ζ 0.04 of the trunk's mode,
+        // a decay time of 1/(ζ ω₀) ≈ 4–7 s), as a tree rings down in still air.
+        for _ in 0..3_600 {
             h.step_packed(&[], &[], &mut s, 1.0 / 60.0);
         }
         let d = s.max_distance(&rest);

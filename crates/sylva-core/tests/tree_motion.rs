@@ -9,6 +9,7 @@
 use glam::Vec3;
 use sylva_core::methods::Method;
 use sylva_core::methods::akagi::{Akagi, AkagiParams};
+use sylva_core::methods::hsm::{Hsm, HsmParams};
 use sylva_core::methods::skjermo::{Skjermo, SkjermoParams};
 use sylva_core::methods::zioma::{Zioma, ZiomaParams};
 use sylva_core::physics::measure::{damping_ratio, linear_fit, ringdown_frequency};
@@ -30,9 +31,17 @@ fn species(name: &str, factor: f64, seed: u64) -> Tree {
     SpeciesSource::WeberPenn { file, params }.generate(seed, &Default::default(), None).unwrap()
 }
 
-/// A small aspen (about 6 m) for the dynamic tests.
+/// A small aspen (about 6 m, a fifth of the leaves: HSM simulates a cluster per leaf) for the
+/// dynamic tests.
 fn small_aspen() -> Tree {
-    species("quaking_aspen", 0.5, 1)
+    let SpeciesSource::WeberPenn { file, mut params } = SpeciesSource::resolve("quaking_aspen").unwrap() else {
+        unreachable!()
+    };
+    params.scale *= 0.5;
+    params.scale_v *= 0.5;
+    params.leaf_scale *= 0.5;
+    params.leaves *= 0.2;
+    SpeciesSource::WeberPenn { file, params }.generate(1, &Default::default(), None).unwrap()
 }
 
 fn constant(speed: f32) -> WindScene {
@@ -133,7 +142,7 @@ fn trunk_frequency_is_independent_of_the_time_step<M: Method>(name: &str, m: imp
     let a = m(&t);
     let f: Vec<f32> = [30.0f32, 60.0, 120.0, 240.0]
         .iter()
-        .map(|&rate| ringing(&pluck(&a, &t, 8.0, 1.0 / rate, 1.5, 12.0), 1.0 / rate))
+        .map(|&rate| ringing(&pluck(&a, &t, 8.0, 1.0 / rate, 1.0, 8.0), 1.0 / rate))
         .collect();
     println!("{name} trunk frequency at 30/60/120/240 Hz: {f:?}");
     let (lo, hi) = (f.iter().cloned().fold(f32::MAX, f32::min), f.iter().cloned().fold(0.0, f32::max));
@@ -142,8 +151,9 @@ fn trunk_frequency_is_independent_of_the_time_step<M: Method>(name: &str, m: imp
 
 /// Step response: a wind that starts at once; the trunk top rings about its new lean with
 /// the structural damping and the air's, which grows with the wind: ζ in 0.02–0.2, rising
-/// from 3 to 6 to 10 m/s.
-fn damping_is_in_the_field_range_and_rises_with_wind<M: Method>(name: &str, m: impl Fn(&Tree) -> M) {
+/// from 3 to 6 to 10 m/s. Peaks count down to `floor` of the first (Zioma's small-branch
+/// chaos rides on its trunk at about a tenth of the lean, so its ring is read above that).
+fn damping_is_in_the_field_range_and_rises_with_wind<M: Method>(name: &str, floor: f32, m: impl Fn(&Tree) -> M) {
     let t = small_aspen();
     let a = m(&t);
     let dt = 1.0 / 60.0;
@@ -158,7 +168,7 @@ fn damping_is_in_the_field_range_and_rises_with_wind<M: Method>(name: &str, m: i
             .collect();
         let lean = x[900..].iter().sum::<f32>() / 300.0;
         let peak = x.iter().map(|v| (v - lean).abs()).fold(0.0, f32::max);
-        let z = damping_ratio(&x[..900], lean, 0.05 * peak).expect("no ringing");
+        let z = damping_ratio(&x[..900], lean, floor * peak).expect("no ringing");
         println!("{name} {speed} m/s: lean {lean:.3} m, ζ {z:.3}");
         assert!((0.02..=0.2).contains(&z), "{name} {speed} m/s: ζ {z}");
         zetas.push(z);
@@ -195,7 +205,7 @@ fn akagi_trunk_frequency_does_not_depend_on_the_time_step() {
 
 #[test]
 fn akagi_damping_is_in_the_field_range_and_rises_with_wind() {
-    damping_is_in_the_field_range_and_rises_with_wind("akagi", |t| Akagi::new(t, AkagiParams::default()));
+    damping_is_in_the_field_range_and_rises_with_wind("akagi", 0.05, |t| Akagi::new(t, AkagiParams::default()));
 }
 
 #[test]
@@ -210,17 +220,52 @@ fn skjermo_trunk_frequency_does_not_depend_on_the_time_step() {
 
 #[test]
 fn skjermo_damping_is_in_the_field_range_and_rises_with_wind() {
-    damping_is_in_the_field_range_and_rises_with_wind("skjermo", |t| Skjermo::new(t, SkjermoParams::default()));
+    damping_is_in_the_field_range_and_rises_with_wind("skjermo", 0.05, |t| Skjermo::new(t, SkjermoParams::default()));
 }
 
-/// Trunk-top sway in `gusty` lies in the field range under Zioma, Akagi and Skjermo, and the
-/// three agree within 2× on the same tree.
 #[test]
-fn zioma_akagi_and_skjermo_sway_half_to_three_percent_of_the_height_in_a_moderate_breeze_within_2x() {
+fn zioma_sways_a_uniform_cantilever_at_the_beam_formula() {
+    sways_a_cantilever_at_the_beam_formula("zioma", |t| Zioma::new(t, ZiomaParams::default()));
+}
+
+#[test]
+fn zioma_trunk_frequency_does_not_depend_on_the_time_step() {
+    trunk_frequency_is_independent_of_the_time_step("zioma", |t| Zioma::new(t, ZiomaParams::default()));
+}
+
+#[test]
+fn zioma_damping_is_in_the_field_range_and_rises_with_wind() {
+    damping_is_in_the_field_range_and_rises_with_wind("zioma", 0.25, |t| Zioma::new(t, ZiomaParams::default()));
+}
+
+fn hsm(t: &Tree) -> Hsm {
+    Hsm::new(t, HsmParams::default()).unwrap()
+}
+
+#[test]
+fn hsm_sways_a_uniform_cantilever_at_the_beam_formula() {
+    sways_a_cantilever_at_the_beam_formula("hsm", hsm);
+}
+
+#[test]
+fn hsm_trunk_frequency_does_not_depend_on_the_time_step() {
+    trunk_frequency_is_independent_of_the_time_step("hsm", hsm);
+}
+
+#[test]
+fn hsm_damping_is_in_the_field_range_and_rises_with_wind() {
+    damping_is_in_the_field_range_and_rises_with_wind("hsm", 0.05, hsm);
+}
+
+/// Trunk-top sway in `gusty` lies in the field range under every method, and the four agree
+/// within 2× on the same tree.
+#[test]
+fn every_method_sways_half_to_three_percent_of_the_height_in_a_moderate_breeze_within_2x() {
     let sways = [
         ("zioma", gusty_sway(|t| Zioma::new(t, ZiomaParams::default()))),
         ("akagi", gusty_sway(|t| Akagi::new(t, AkagiParams::default()))),
         ("skjermo", gusty_sway(|t| Skjermo::new(t, SkjermoParams::default()))),
+        ("hsm", gusty_sway(hsm)),
     ];
     println!("aspen trunk-top sway, % of height: {:?}", sways.map(|(n, x)| (n, 100.0 * x)));
     for (name, x) in sways {
@@ -451,8 +496,8 @@ fn turn_rates<M: Method>(
 /// and the new ones in ([`WindScene::blend_waves`], 1 s each) leaves no spike in any segment's
 /// angular speed: through the change, the fastest turn of each stem level stays within 1.25×
 /// the fastest seen in steady wind before or after it. The same change made at once jumps
-/// Zioma's trunk and branches (its pose is a closed form of the wind) past 2× — the measure
-/// sees a spike where there is one.
+/// Zioma's branches (closed forms of the wind; only its trunk carries a ring across a
+/// change) past 1.5× — the measure sees a spike where there is one.
 #[test]
 fn changing_the_waves_blends_without_a_spike_in_any_segment_s_angular_velocity() {
     use std::sync::Arc;
@@ -509,7 +554,7 @@ fn changing_the_waves_blends_without_a_spike_in_any_segment_s_angular_velocity()
     };
     let z = Zioma::new(&t, ZiomaParams::default());
     let jump = check("zioma", &turn_rates(&z, &t, 18.0, &winds(false)), &turn_rates(&z, &t, 18.0, &winds(true)));
-    assert!(jump > 2.0, "zioma: switching at once turns at most {jump}× as fast as in steady wind");
+    assert!(jump > 1.5, "zioma: switching at once turns at most {jump}× as fast as in steady wind");
     let a = Akagi::new(&t, AkagiParams::default());
     check("akagi", &turn_rates(&a, &t, 18.0, &winds(false)), &turn_rates(&a, &t, 18.0, &winds(true)));
     let sk = Skjermo::new(&t, SkjermoParams::default());

@@ -218,6 +218,38 @@ fn zioma_matches_on_every_preset_at_random_times() {
     }
 }
 
+/// When the wind stops, the GPU's trunk rings down as the CPU's state does (`set_wind` starts
+/// the same ring): a second into the calm the poses agree within 1e-4 × height, and the tree
+/// is still moving.
+#[test]
+fn zioma_rings_down_on_the_gpu_as_on_the_cpu_when_the_wind_stops() {
+    use sylva_core::methods::Method;
+    use sylva_core::wind::PackedWind;
+    use sylva_gpu::methods::GpuAnimator;
+    let Some(ctx) = common::gpu() else { return };
+    let wind = WindScene::resolve("gusty").unwrap();
+    let (fw, calm) = (wind.packed(), PackedWind::calm());
+    let t = SpeciesSource::resolve("stochastic_bush").unwrap().generate(4, &Default::default(), None).unwrap();
+    let z = Zioma::new(&t, ZiomaParams::default());
+    let mut gpu =
+        GpuZioma::new(ctx, Arc::new(t.clone()), z.clone(), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
+    let mut s = z.rest_state(&t);
+    for _ in 0..300 {
+        z.step(&t, &fw, &mut s, 1.0 / 60.0);
+    }
+    gpu.advance(ctx, 1.0 / 60.0, 300);
+    gpu.set_wind(&GpuWind::calm(ctx).unwrap());
+    for _ in 0..60 {
+        z.step(&t, &calm, &mut s, 1.0 / 60.0);
+    }
+    gpu.advance(ctx, 1.0 / 60.0, 60);
+    let cpu = z.pose(&t, &calm, &s);
+    let time = gpu.time;
+    assert_eq!(time, s.time);
+    compare(&t, &cpu, &gpu.pose(ctx, time).unwrap(), "a second into the calm");
+    assert_ne!(cpu, Pose::rest(&t), "the trunk does not ring");
+}
+
 #[test]
 fn zioma_on_the_gpu_is_at_rest_in_still_air() {
     let Some(ctx) = common::gpu() else { return };

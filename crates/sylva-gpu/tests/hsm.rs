@@ -40,7 +40,7 @@ fn hsm_one_substep_matches_from_random_states() {
         [("quaking_aspen", 0.0, false), ("ca_black_oak", 0.3, false), ("stochastic_bush", 0.0, true)]
     {
         let t = tree(name);
-        let params = HsmParams { substeps: 1, beta, fused, ..Default::default() };
+        let params = HsmParams { substep_rate: 240.0, beta, fused, ..Default::default() };
         let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(3000)).unwrap());
         let mut state = h.state_at_rest();
         for (p, v) in state.displacement.iter_mut().zip(state.velocity.iter_mut()) {
@@ -69,7 +69,11 @@ fn hsm_one_substep_matches_from_random_states() {
         assert!(fused || cpu.goal != state.goal, "{name}: no goals written");
         for (i, (a, b)) in cpu.goal.iter().zip(&g.goal).enumerate() {
             let e = (Vec3::from_slice(&a[..3]) - Vec3::from_slice(&b[..3])).length();
-            assert!(e <= tol && (a[3] - b[3]).abs() <= 1e-6, "{name}: goal {i} CPU {a:?} GPU {b:?}");
+            // w: the summed weights, which pass 1 on shared rings (rounding relative to them).
+            assert!(
+                e <= tol && (a[3] - b[3]).abs() <= 1e-6 * a[3].abs().max(1.0),
+                "{name}: goal {i} CPU {a:?} GPU {b:?}"
+            );
         }
         for (c, (a, b)) in cpu.clusters.iter().zip(&g.clusters).enumerate() {
             let qa = glam::Quat::from_array(a.rotation);
@@ -95,7 +99,7 @@ fn hsm_matches_after_1000_steps_on_every_preset() {
     let fw = wind.packed();
     for p in PRESETS {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
-        let params = HsmParams { substeps: 1, ..Default::default() };
+        let params = HsmParams { substep_rate: 240.0, ..Default::default() };
         let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(150)).unwrap());
         let mut cpu = h.state_at_rest();
         let mut gpu =
@@ -120,7 +124,8 @@ fn hsm_matches_after_1000_steps_on_every_preset() {
     }
 }
 
-/// Whole trees (every cluster) for 30 steps of 4 substeps: within 1e-4 × tree height.
+/// Whole trees (every cluster), calibrated to their wood, for 30 steps of 4 substeps
+/// (240 Hz, where the calibrated hold is under 1): within 1e-4 × tree height.
 #[test]
 fn hsm_whole_trees_match_on_the_gpu() {
     let Some(ctx) = common::gpu() else { return };
@@ -128,7 +133,8 @@ fn hsm_whole_trees_match_on_the_gpu() {
     let fw = wind.packed();
     for name in ["quaking_aspen", "stochastic_bush", "palm"] {
         let t = tree(name);
-        let h = Hsm::new(&t, HsmParams::default()).unwrap();
+        let h = Hsm::new(&t, HsmParams { substep_rate: 240.0, ..Default::default() }).unwrap();
+        assert!(h.hold(1.0 / 240.0) < 1.0, "{name}: the hold is {}", h.hold(1.0 / 240.0));
         let mut cpu = h.state_at_rest();
         let mut gpu =
             GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap())

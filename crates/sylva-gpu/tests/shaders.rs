@@ -401,6 +401,7 @@ fn hsm_structs_match_their_wgsl_twins() {
             ("clusters", offset_of!(RawHsmStep, clusters)),
             ("particles", offset_of!(RawHsmStep, particles)),
             ("max_children", offset_of!(RawHsmStep, max_children)),
+            ("hold", offset_of!(RawHsmStep, hold)),
         ],
     );
 }

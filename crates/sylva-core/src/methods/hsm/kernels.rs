@@ -137,15 +137,16 @@ pub const NEWTON_NEAR: f32 = 0.05;
 ///
 /// A cluster's weight is `w = k h²`, its rate `k` (1/s²) times the substep squared; a
 /// particle shared by several clusters goes to the `w`-weighted mean of their goals, the
-/// point where their spring forces `m k_c (g_c − x)` balance, and moves `ᾱ = min(1, Σ w)`
-/// of the way there. That clamp keeps Müller's unconditional stability (a particle never
-/// passes its goal). The weights are **not** clamped at 1:
+/// point where their spring forces `m k_c (g_c − x)` balance, and moves `ᾱ = min(Σ w, hold)`
+/// of the way there ([`RawHsmStep::hold`], never above 1). That clamp keeps Müller's
+/// unconditional stability (a particle never passes its goal). The weights are **not**
+/// clamped at the hold:
 /// * Clamped (Müller's per-cluster `α = min(1, k h²)`), every cluster stiffer than `1/h²`
 ///   had an equal say, so a thick stem held the ring it shares with a twig or a leaf no
 ///   better than the twig did, and a joint resisted only about `m r² / h²` (its ring's mass
 ///   and lever). The stochastic bush, whose 3 cm stems are ~50× stiffer than that at
 ///   240 Hz, lay down in gusty wind: segment ends 2.0 m from rest on a 2.3 m bush.
-/// * A weight passes 1 only up to `k̂ h²`, `k̂` the smallest rate on the cluster's path to
+/// * A weight passes the hold only up to `k̂ h²`, `k̂` the smallest rate on the cluster's path to
 ///   the root ([`crate::methods::hsm::RawHsmCluster::aqq_inv`]'s first w). A cluster pulls
 ///   the parent's rings it reaches into (`overlap`) at its own rate, and a thin twig's rate
 ///   can be high only because it is light: unbounded, monopodial's laterals dragged its
@@ -280,8 +281,8 @@ fn finish_cluster(
             t = a * (step.beta / det.powf(1.0 / 3.0)) + r * (1.0 - step.beta);
         }
     }
-    // The cluster's weight k h², past 1 only up to its path's k̂ h² (see `MAX_WEIGHT`).
-    let bound = (cl.aqq_inv[0][3] * step.dt * step.dt).max(1.0);
+    // The cluster's weight k h², past the hold only up to its path's k̂ h² (see `MAX_WEIGHT`).
+    let bound = (cl.aqq_inv[0][3] * step.dt * step.dt).max(step.hold);
     let weight = (cl.rest_cm[3] * step.dt * step.dt).min(bound).min(MAX_WEIGHT);
     st.cm = [cm.x, cm.y, cm.z, weight];
     st.rotation = q.to_array();
@@ -392,7 +393,7 @@ fn particle_goal(i: usize, member_offset: &[u32], member: &[RawHsmMember], state
         sum += goal_displacement(st, Vec3A::from_array(m.q)) * st.cm[3];
         wsum += st.cm[3];
     }
-    if wsum > 0.0 { with_xyz(sum / wsum, wsum.min(1.0)) } else { [0.0; 4] }
+    if wsum > 0.0 { with_xyz(sum / wsum, wsum) } else { [0.0; 4] }
 }
 
 /// A cluster's goal for rest offset `q`, as a displacement from rest: `(T q − q) + (c − c⁰)`.
@@ -405,7 +406,8 @@ fn goal_displacement(st: &RawHsmClusterState, q: Vec3A) -> Vec3A {
     (tq - q) + shift
 }
 
-/// A free particle's new velocity: the pull toward goal `g` (w = ᾱ) from `u` (both
+/// A free particle's new velocity: the pull toward goal `g` (w = Σ w, ᾱ its minimum with
+/// the hold) from `u` (both
 /// displacements from rest, so `g − u` is the goal minus the position), gravity,
 /// semi-implicit drag toward `wind` with drag factor `kd`, damping. WGSL: `hsm_velocity`.
 #[inline(always)]
@@ -413,7 +415,7 @@ fn particle_velocity(v: Vec3A, g: [f32; 4], u: Vec3A, wind: Vec3A, kd: f32, step
     let h = step.dt;
     let gravity = Vec3A::from_array([step.gravity[0], step.gravity[1], step.gravity[2]]);
     // ᾱ / h as ᾱ · (1 / h): one division per step, not per particle.
-    let mut vel = v + (a3(g) - u) * (g[3] * (1.0 / h)) + gravity * ((1.0 - step.gravity[3]) * h);
+    let mut vel = v + (a3(g) - u) * (g[3].min(step.hold) * (1.0 / h)) + gravity * ((1.0 - step.gravity[3]) * h);
     let rel = wind - vel;
     let s = h * kd * rel.length();
     vel += rel * (s / (1.0 + s));
@@ -433,7 +435,7 @@ fn with_xyz(v: Vec3A, w: f32) -> [f32; 4] {
 }
 
 /// Stage 3, per particle: the mean of its clusters' goals `T_c q + c_c` weighted by their
-/// `w_c = k_c h²`, and `ᾱ = min(1, Σ w_c)` (see [`MAX_WEIGHT`]). Goals are kept as
+/// `w_c = k_c h²`, and `Σ w_c` (stage 4 moves `ᾱ = min(Σ w_c, hold)`, see [`MAX_WEIGHT`]). Goals are kept as
 /// displacements from rest, `(T q − q) + (c − c⁰)`, so a cluster at rest gives exactly
 /// zero. Bindings: 0 member offsets, 1 members, 2 cluster state, 3 goals.
 pub fn hsm_goals(member_offset: &[u32], member: &[RawHsmMember], state: &[RawHsmClusterState], goal: &mut [[f32; 4]]) {

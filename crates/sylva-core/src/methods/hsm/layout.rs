@@ -35,6 +35,11 @@ pub struct HsmLayout {
     pub segment_cluster: Vec<u32>,
     /// Largest number of child clusters of any cluster.
     pub max_children: u32,
+    /// Factor on every segment and stem cluster's rate since they were derived from the
+    /// wood (see [`super::HsmParams::calibrate`]); 1 as built.
+    pub rate_scale: f32,
+    /// The trunk's first-mode frequency from the wood, Hz ([`crate::physics::stem_frequencies`]).
+    pub sway_hz: f32,
 }
 
 struct Builder {
@@ -93,6 +98,8 @@ impl HsmLayout {
                 member: Vec::new(),
                 segment_cluster: vec![NONE; s.len()],
                 max_children: 0,
+                rate_scale: 1.0,
+                sway_hz: crate::physics::stem_frequencies(tree, params.min_radius).hz(0),
             },
             rings: Vec::with_capacity(total_clusters),
             pos: Vec::new(),
@@ -312,14 +319,7 @@ impl HsmLayout {
                 aqq_inv: [inv.x_axis.extend(0.0).into(), inv.y_axis.extend(0.0).into(), inv.z_axis.extend(0.0).into()],
             });
         }
-        // Each cluster's rate bound k̂: the smallest rate on its path to the root, itself
-        // included (clusters come after their parents, so one pass carries it down). Stage 1
-        // lets a cluster's weight pass 1 only up to k̂ h² (see `kernels::MAX_WEIGHT`).
-        for c in 0..n_clusters {
-            let p = parents[c];
-            let own = clusters[c].rest_cm[3];
-            clusters[c].aqq_inv[0][3] = if p == NONE { own } else { own.min(clusters[p as usize].aqq_inv[0][3]) };
-        }
+        path_bounds(&mut clusters);
         // Each particle's (cluster, slot) pairs, in cluster order.
         let mut count = vec![0u32; n_particles + 1];
         for s in &slots {
@@ -381,6 +381,18 @@ impl HsmLayout {
         Ok(out)
     }
 
+    /// Multiplies every segment and stem cluster's rate by `s` (leaves keep theirs) and
+    /// recomputes the path bounds; [`Self::rate_scale`] keeps the product.
+    pub fn scale_rates(&mut self, s: f32) {
+        for (c, info) in self.clusters.iter_mut().zip(&self.info) {
+            if info.kind != kind::LEAF {
+                c.rest_cm[3] *= s;
+            }
+        }
+        path_bounds(&mut self.clusters);
+        self.rate_scale *= s;
+    }
+
     /// Number of clusters.
     pub fn cluster_count(&self) -> usize {
         self.info.len()
@@ -416,5 +428,16 @@ impl HsmLayout {
         } else {
             stage1 + stage3 + stage4
         }
+    }
+}
+
+/// Each cluster's rate bound k̂: the smallest rate on its path to the root, itself included
+/// (clusters come after their parents, so one pass carries it down). Stage 1 lets a
+/// cluster's weight pass the hold only up to k̂ h² (see `kernels::MAX_WEIGHT`).
+fn path_bounds(clusters: &mut [RawHsmCluster]) {
+    for c in 0..clusters.len() {
+        let p = clusters[c].parent;
+        let own = clusters[c].rest_cm[3];
+        clusters[c].aqq_inv[0][3] = if p == NONE { own } else { own.min(clusters[p as usize].aqq_inv[0][3]) };
     }
 }

@@ -36,10 +36,11 @@
 //!    `β = 0` is pure rotation), the cluster's weight `w = k h²` and the wind at `c`.
 //! 2. Synchronisation: the end of the dispatch.
 //! 3. `hsm_goals` (per particle): over the clusters sharing it, `g_c = T_c q + c_c`; the goal
-//!    is the weighted mean `ĝ = Σ w_c g_c / Σ w_c` with `ᾱ = min(1, Σ w_c)` (Table 1
-//!    steps 3–4 take `Σ α / n`; with n, a ring shared by twenty leaves had its segment's
-//!    hold diluted twentyfold).
-//! 4. `hsm_integrate` (per particle): `v += ᾱ (ĝ − x) / h + h g` (Table 1 steps 5–6; a
+//!    is the weighted mean `ĝ = Σ w_c g_c / Σ w_c`, kept with `Σ w_c` (Table 1 steps 3–4
+//!    take `Σ α / n`; with n, a ring shared by twenty leaves had its segment's hold
+//!    diluted twentyfold).
+//! 4. `hsm_integrate` (per particle): `v += ᾱ (ĝ − x) / h + h g` with
+//!    `ᾱ = min(Σ w_c, hold)` (see "Stiffness" below; Table 1 steps 5–6; a
 //!    prestressed tree's support cancels g, see [`HsmParams::prestressed`]),
 //!    drag toward the wind `u` sampled at its cluster's centre (a leaf's segment's)
 //!    `v += (u − v) s / (1 + s)`,
@@ -53,17 +54,26 @@
 //! substep of a step in one submission.
 //!
 //! **Stiffness** is a rate, not a per-step fraction: a cluster's weight is `w = k h²` with
-//! `k` in 1/s² (from the wood's `E·I/L`, trunk stiffest). Where `Σ w < 1`,
+//! `k` in 1/s² (from the wood's `E·I/L`, trunk stiffest). Where `Σ w` is under the hold,
 //! `v += k h (g − x)` is a spring of angular frequency √k integrated by symplectic Euler and
-//! the static sag under gravity (`x − g = g/k`) does not depend on the step; the clamp
-//! `ᾱ ≤ 1` keeps Müller's unconditional stability. The weights themselves may pass 1 (up
-//! to the smallest rate on the cluster's path to the root): a shared particle's goal is
-//! where its clusters' spring forces balance, so a thick stem holds the ring it shares
-//! with a twig or a leaf (see [`crate::methods::hsm::kernels::MAX_WEIGHT`]). What the clamp still
-//! limits: a joint between two clusters that are both stiffer than `1/h²` resists bending
-//! by about `m L² / h²` (its shared particles' mass and lever), less than the wood of
-//! short, thick segments. Such trees bend more than Akagi's beam model says unless the
-//! substeps rise (`docs/PERFORMANCE.md`, "HSM stiffness against the wood's").
+//! the static sag under gravity (`x − g = g/k`) does not depend on the step. The weights
+//! themselves may pass the hold (up to the smallest rate on the cluster's path to the
+//! root): a shared particle's goal is where its clusters' spring forces balance, so a thick
+//! stem holds the ring it shares with a twig or a leaf (see
+//! [`crate::methods::hsm::kernels::MAX_WEIGHT`]).
+//!
+//! **The hold** is a rate of the tree, not of the step: `ᾱ = min(Σ w, s (r h)²)` with `r`
+//! the substep rate ([`HsmParams::substep_rate`]) and `s` the rate scale. Short, thick
+//! segments, and rings shared by hundreds of twigs, are stiffer than any affordable
+//! explicit step can hold; Müller's clamp `ᾱ ≤ 1` held them at `1/h²`, so a tree's
+//! frequency rose with the substeps (the small aspen 0.95 → 5.9 Hz from 240 to 3,840
+//! substeps/s). The hold scales such a particle's pull as if its mass were `Σ w / hold`
+//! times larger (mass scaling), by the same factor at any step, and substeps rise until
+//! `s (r h)² ≤ 1`, so Müller's stability is kept and the same tree sways alike at 30, 60,
+//! 120 or 240 frames/s. The scale `s` comes from the wood ([`calibrate`]): the trunk,
+//! plucked once when the method is built, sways at its first mode from
+//! [`crate::physics::stem_frequencies`]. Damping is a ratio of that mode
+//! ([`HsmParams::damping_ratio`]); the drag adds the air's.
 //!
 //! **Rotation**: `R` is extracted by the iterative method of Müller, Bender, Chentanez &
 //! Macklin (2016), warm-started from the last step's R, `R ← rot(ω) R` (the unit
@@ -84,6 +94,7 @@
 //! The cluster transform `R (x⁰ − c⁰) + c` of a joint stays within a few millimetres of it
 //! (see the tests).
 
+pub mod calibrate;
 pub mod kernels;
 pub mod layout;
 pub mod raw;
@@ -142,10 +153,12 @@ pub struct HsmParams {
     pub min_radius: f32,
     /// Stiffness of leaf clusters, 1/s². Default 900 (30 rad/s): leaves flutter.
     pub leaf_stiffness: f32,
-    /// Velocity damping rate c, 1/s: `v *= e^{−c h}` each substep. Default 2: a branch
-    /// released in still air rings down within a few seconds, as wood and air damp it
-    /// (damping ratios 0.05–0.3), on top of the aerodynamic damping of the drag.
-    pub damping: f32,
+    /// Structural damping ratio ζ of the trunk's first mode: velocities are damped at the
+    /// rate `c = 2 ζ ω₀` (`v *= e^{−c h}` each substep), ω₀ the trunk's frequency from the
+    /// wood ([`crate::physics::stem_frequencies`]), so the ratio holds at any step. The
+    /// drag adds the air's damping, which rises with the wind. Default
+    /// [`crate::physics::STRUCTURAL_DAMPING`] (0.04), as Akagi and Skjermo.
+    pub damping_ratio: f32,
     /// Drag coefficient of bark (a cylinder in cross-flow ≈ 1.0–1.2). Default 0.8.
     pub drag: f32,
     /// Drag coefficient per (one-sided) leaf area. Default 0.05: leaves shelter one
@@ -179,11 +192,24 @@ pub struct HsmParams {
     /// the same bits again. False runs Song's four stages as published and keeps
     /// [`HsmState::goal`] up to date (the fused pass leaves it as it was).
     pub fused: bool,
-    /// Substeps per `step` call. Default 4: 240 Hz at 60 frames/s, where the clusters of
-    /// long, slender trees (aspen, poplar, fir) have weights `k h²` below 1, so their sag
-    /// and sway do not depend on the frame rate. Trees of short, thick segments are stiffer
-    /// than 240 Hz can hold and bend less as substeps rise (module notes, "Stiffness").
+    /// Fewest substeps per `step` call. Default 1: [`Self::substep_rate`] sets how many.
     pub substeps: u32,
+    /// Substep rate r, Hz: a step of `dt` runs at least `⌈dt · r √max(s, 1)⌉` substeps (s
+    /// the rate scale, see [`Self::calibrate`]), and a particle is held at no more than the
+    /// rate `s r²` (1/s²) whatever the substep, `ᾱ = min(Σ w, s (r h)²)`. The wood of short,
+    /// thick segments is stiffer than any affordable explicit step can hold; with the hold
+    /// a rate of the tree, not of the step, the same tree sways at the same frequency at 30,
+    /// 60, 120 or 240 frames/s. Default 240 (four substeps at 60 frames/s). 0: exactly
+    /// `substeps` substeps with Müller's clamp `ᾱ ≤ 1` (Song's tables), so the stiffness
+    /// then follows the step.
+    pub substep_rate: f32,
+    /// Scale every segment and stem cluster's rate (and the hold) so that the trunk sways at
+    /// its first mode from the wood, [`crate::physics::stem_frequencies`] (times
+    /// `√stiffness_scale`): HSM's trunk is plucked once when the method is built and its
+    /// frequency measured (see [`calibrate`]). Default true: shape matching's clusters have
+    /// a rate each but no modulus, and their ring levers make a chain of them stiffer than
+    /// the beam it stands for. Leaves keep [`Self::leaf_stiffness`]. Needs `substep_rate > 0`.
+    pub calibrate: bool,
 }
 
 impl Default for HsmParams {
@@ -198,7 +224,7 @@ impl Default for HsmParams {
             stiffness_scale: 1.0,
             min_radius: 0.0015,
             leaf_stiffness: 900.0,
-            damping: 2.0,
+            damping_ratio: crate::physics::STRUCTURAL_DAMPING,
             drag: 0.8,
             leaf_drag: 0.05,
             gravity: 9.81,
@@ -206,7 +232,9 @@ impl Default for HsmParams {
             beta: 0.0,
             polar_iterations: 2,
             fused: true,
-            substeps: 4,
+            substeps: 1,
+            substep_rate: 480.0,
+            calibrate: true,
         }
     }
 }
@@ -215,9 +243,18 @@ impl HsmParams {
     /// The cluster sizes of Song's Tables 2 and 3 (42–60 particles per cluster): segment
     /// clusters of 4 rings of 14 (42 particles of their own, 56 at the root), leaves of 42
     /// blade particles, no stem clusters (the paper's counts have none), one substep per step
-    /// (the paper's frame is one shape-matching pass).
+    /// (the paper's frame is one shape-matching pass, Müller's clamp, no calibration).
     pub fn song_tables() -> Self {
-        Self { rings: 4, ring_size: 14, leaf_particles: 42, stem_clusters: false, substeps: 1, ..Self::default() }
+        Self {
+            rings: 4,
+            ring_size: 14,
+            leaf_particles: 42,
+            stem_clusters: false,
+            substeps: 1,
+            substep_rate: 0.0,
+            calibrate: false,
+            ..Self::default()
+        }
     }
 }
 
@@ -234,6 +271,13 @@ pub enum HsmError {
 
 /// Largest number of particles (and of slots) in one layout: 64 million (≈ 4 GB of state).
 pub const MAX_PARTICLES: usize = 64 << 20;
+
+/// Highest [`HsmParams::substep_rate`], Hz.
+pub const MAX_SUBSTEP_RATE: f32 = 100_000.0;
+
+/// Most substeps one `step` call runs (a step of `dt` beyond `MAX_SUBSTEPS / r` seconds
+/// runs this many, longer ones).
+pub const MAX_SUBSTEPS: u32 = 1 << 16;
 
 impl HsmParams {
     /// Checks every field's range.
@@ -262,12 +306,13 @@ impl HsmParams {
         if !(self.min_radius.is_finite() && self.min_radius >= 0.0) {
             return bad("min_radius", self.min_radius, "expected a finite number ≥ 0 (m)");
         }
-        for (field, v) in [
-            ("damping", self.damping),
-            ("drag", self.drag),
-            ("leaf_drag", self.leaf_drag),
-            ("gravity", self.gravity.abs()),
-        ] {
+        if !(self.damping_ratio.is_finite() && (0.0..=10.0).contains(&self.damping_ratio)) {
+            return bad("damping_ratio", self.damping_ratio, "expected 0 to 10");
+        }
+        if !(self.substep_rate.is_finite() && (0.0..=MAX_SUBSTEP_RATE).contains(&self.substep_rate)) {
+            return bad("substep_rate", self.substep_rate, "expected 0 to 100000 (Hz)");
+        }
+        for (field, v) in [("drag", self.drag), ("leaf_drag", self.leaf_drag), ("gravity", self.gravity.abs())] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(field, v, "expected a finite number ≥ 0");
             }
@@ -296,7 +341,7 @@ pub struct HsmState {
     pub velocity: Vec<[f32; 4]>,
     /// Per-cluster results of the last substep.
     pub clusters: Vec<RawHsmClusterState>,
-    /// Goal as a displacement from rest (xyz, m) and ᾱ (w) of each particle from the last
+    /// Goal as a displacement from rest (xyz, m) and Σ w (w) of each particle from the last
     /// substep.
     pub goal: Vec<[f32; 4]>,
     /// Simulated time, s.
@@ -338,10 +383,32 @@ pub struct Hsm {
 }
 
 impl Hsm {
-    /// Builds the clusters of every segment and leaf of `tree`.
+    /// Builds the clusters of every segment and leaf of `tree`, calibrated to its wood when
+    /// [`HsmParams::calibrate`] is set.
     pub fn new(tree: &Tree, params: HsmParams) -> Result<Self, HsmError> {
         let layout = HsmLayout::new(tree, &params, None)?;
-        Ok(Self::from_layout(tree, params, layout))
+        let mut hsm = Self::from_layout(tree, params, layout);
+        if params.calibrate && params.substep_rate > 0.0 {
+            let target = hsm.layout.sway_hz * params.stiffness_scale.sqrt();
+            if let Some(f) = calibrate::trunk_frequency(tree, &hsm) {
+                hsm.layout.scale_rates((target / f).powi(2).clamp(1e-4, 1e4));
+            }
+        }
+        Ok(hsm)
+    }
+
+    /// Substeps for a step of `dt` seconds (see [`HsmParams::substep_rate`]).
+    pub fn substeps(&self, dt: f32) -> u32 {
+        let p = &self.params;
+        let rate = p.substep_rate * self.layout.rate_scale.max(1.0).sqrt();
+        let n = (dt * rate - 1e-4).ceil();
+        (if n.is_finite() { n.clamp(1.0, MAX_SUBSTEPS as f32) as u32 } else { 1 }).max(p.substeps)
+    }
+
+    /// The hold `s (r h)²` of a substep `h` (1 without a substep rate; see [`RawHsmStep::hold`]).
+    pub fn hold(&self, h: f32) -> f32 {
+        let r = self.params.substep_rate;
+        if r > 0.0 { (self.layout.rate_scale * (r * h).powi(2)).min(1.0) } else { 1.0 }
     }
 
     /// Uses a prepared layout (truncated or a forest).
@@ -391,19 +458,25 @@ impl Hsm {
             gravity: [0.0, -p.gravity, 0.0, if p.prestressed { 1.0 } else { 0.0 }],
             dt,
             time,
-            damping: (-p.damping * dt).exp(),
+            damping: (-2.0 * p.damping_ratio * std::f32::consts::TAU * self.layout.sway_hz * dt).exp(),
             beta: p.beta,
             polar_iterations: p.polar_iterations,
             clusters: self.layout.info.len() as u32,
             particles: self.layout.rest.len() as u32,
             max_children: self.layout.max_children,
+            hold: self.hold(dt),
+            _pad: [0.0; 3],
         }
     }
 
     /// One substep: the four stages.
     pub fn substep(&self, fields: &[RawField], waves: &[RawWave], state: &mut HsmState, h: f32) {
+        self.substep_with(fields, waves, state, self.step_params(state.time + h, h));
+    }
+
+    /// One substep with the given step values.
+    pub fn substep_with(&self, fields: &[RawField], waves: &[RawWave], state: &mut HsmState, step: RawHsmStep) {
         let l = &self.layout;
-        let step = self.step_params(state.time + h, h);
         hsm_clusters_groups(fields, waves, l, &self.groups, &state.displacement, step, &mut state.clusters);
         if self.params.fused {
             hsm_particles_runs(l, &self.runs, &state.clusters, step, &mut state.displacement, &mut state.velocity);
@@ -414,10 +487,10 @@ impl Hsm {
         state.time = step.time;
     }
 
-    /// Advances `state` by `dt` seconds in `params.substeps` substeps ([`Method::step`] with
+    /// Advances `state` by `dt` seconds in [`Self::substeps`] substeps ([`Method::step`] with
     /// the wind's packed arrays).
     pub fn step_packed(&self, fields: &[RawField], waves: &[RawWave], state: &mut HsmState, dt: f32) {
-        let n = self.params.substeps.max(1);
+        let n = self.substeps(dt);
         let h = dt / n as f32;
         for _ in 0..n {
             self.substep(fields, waves, state, h);

@@ -118,6 +118,12 @@ pub struct RawHsmStep {
     pub particles: u32,
     /// Largest number of child clusters of any cluster.
     pub max_children: u32,
+    /// The most a particle moves toward its goal in one substep, `ᾱ = min(Σ w, hold)`,
+    /// and the least bound on a cluster's weight: `s (r h)²` for substep rate `r` and rate
+    /// scale `s` (see [`super::HsmParams::substep_rate`]), never above 1.
+    pub hold: f32,
+    /// Padding to 16 bytes.
+    pub _pad: [f32; 3],
 }
 
 /// [`super::HsmState::velocity`]'s w for a fixed particle (free ones carry their drag factor ≥ 0).

@@ -303,10 +303,11 @@ pub(crate) mod avx2 {
             for &c in clusters {
                 wsum += state[c as usize].cm[3];
             }
-            // `particle_goal`: sum / wsum and ᾱ = min(1, wsum), or zero without weight.
+            // `particle_goal`: sum / wsum, or zero without weight; `particle_velocity`:
+            // ᾱ = min(wsum, hold).
             let weighted = wsum > 0.0;
             let wsum_v = _mm256_set1_ps(wsum);
-            let scale = _mm256_set1_ps(if weighted { wsum.min(1.0) * inv_h } else { 0.0 });
+            let scale = _mm256_set1_ps(if weighted { wsum.min(step.hold) * inv_h } else { 0.0 });
             let wind: [__m256; 3] = std::array::from_fn(|c| _mm256_set1_ps(state[run.owner as usize].wind[c]));
             let len = run.len as usize;
             let padded = len.next_multiple_of(WIDTH);

@@ -1,6 +1,11 @@
 //! Zioma's procedural wind animation (GPU Gems 3, ch. 6, §6.3–6.5).
 //!
-//! Stateless: the pose at time t is a function of (tree, wind, t) alone.
+//! Stateless but for one ring: the pose at time t is a function of (tree, wind, t) and, once
+//! the wind has changed, of the trunk's ring-down since ([`trunk::Ring`], a closed form in
+//! t too). The stateless entry points ([`Zioma::pose_at`], [`Zioma::rotations_packed`],
+//! [`Zioma::rotations_instances`]) take the wind as blowing since t = 0 from still air: the
+//! tree starts upright and swings into its lean. Instances share the ring taken at the tree's
+//! own crown.
 //!
 //! * **Trunk** (§6.3.3, Ota 2003): the wind at the crown's centre passed wave by wave through
 //!   a damped oscillator at the trunk's own frequency ([`trunk`]); the trunk leans by that
@@ -40,6 +45,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 use rotations::zioma_rotations;
 use std::sync::Arc;
+pub use trunk::Ring;
 use trunk::{TrunkModel, TrunkNoise};
 
 /// Simulation level of detail (§6.5).
@@ -87,11 +93,16 @@ impl ZiomaParams {
     }
 }
 
-/// Zioma's state: the time alone (the pose is a closed form in t).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// Zioma's state: the time, and the trunk's ring-down since the wind last changed (the pose
+/// is a closed form in t).
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct ZiomaState {
     /// Time, s.
     pub time: f32,
+    /// The trunk's ring-down since the wind last changed.
+    pub ring: Ring,
+    /// The wind the last step took (`None`: still air, not yet stepped).
+    pub wind: Option<PackedWind>,
 }
 
 /// The registry's CPU constructor: Zioma's method on `tree` with `options`.
@@ -159,10 +170,21 @@ impl Zioma {
         Self { params, stems, crown_centre, trunk, tree_seed: mix64(params.seed) as u32, raw: tree.raw_segments() }
     }
 
+    /// The ring that keeps the trunk continuous when the wind changes from `old` (ringing by
+    /// `ring`) to `new` at time `t`, taken at the tree's crown.
+    pub fn ring_after(&self, old: &PackedWind, new: &PackedWind, ring: &Ring, t: f32) -> Ring {
+        self.trunk.ring_after((&old.fields, &old.waves), (&new.fields, &new.waves), ring, self.crown_centre, t)
+    }
+
+    /// The ring of a wind blowing since t = 0 from still air.
+    pub fn start_ring(&self, fields: &[RawField], waves: &[RawWave]) -> Ring {
+        self.trunk.ring_after((&[], &[]), (fields, waves), &Ring::default(), self.crown_centre, 0.0)
+    }
+
     /// The per-frame values at time `t`: wind at the crown, trunk angles and their rate (the
-    /// tree at the origin, unturned).
-    pub fn frame(&self, fields: &[RawField], waves: &[RawWave], t: f32) -> RawZiomaFrame {
-        self.frame_for(fields, waves, t, None)
+    /// tree at the origin, unturned), ringing by `ring`.
+    pub fn frame(&self, fields: &[RawField], waves: &[RawWave], t: f32, ring: &Ring) -> RawZiomaFrame {
+        self.frame_for(fields, waves, t, None, ring)
     }
 
     /// The per-frame values of one instance (`None`: the tree at the origin, unturned).
@@ -172,6 +194,7 @@ impl Zioma {
         waves: &[RawWave],
         t: f32,
         instance: Option<&ZiomaInstance>,
+        ring: &Ring,
     ) -> RawZiomaFrame {
         let (centre, seed) = match instance {
             Some(i) => (i.to_world(self.crown_centre), self.tree_seed ^ i.seed),
@@ -180,7 +203,7 @@ impl Zioma {
         // The trunk's lean (its oscillator's answer to the wind, horizontal, in the tree's
         // frame), with chaos bands on top.
         let lean = |t: f32| {
-            let b = self.trunk.bend(fields, waves, centre, t);
+            let b = self.trunk.bend(fields, waves, centre, t) + self.trunk.ring_at(ring, t).0;
             let b = instance.map_or(b, |i| i.to_local(b));
             let theta = b.length().min(trunk::MAX_TRUNK_BEND);
             (b.try_normalize().unwrap_or(Vec3::ZERO), TrunkNoise::new(self.trunk.natural_frequency, theta))
@@ -213,12 +236,14 @@ impl Zioma {
         waves: &[RawWave],
         t: f32,
         instances: &[ZiomaInstance],
+        ring: &Ring,
     ) -> Vec<RawZiomaFrame> {
-        instances.par_iter().map(|i| self.frame_for(fields, waves, t, Some(i))).collect()
+        instances.par_iter().map(|i| self.frame_for(fields, waves, t, Some(i), ring)).collect()
     }
 
     /// Per-segment rotations δ of every instance at time `t`, instance by instance
-    /// (`instances.len() × segments`), all in one parallel pass (CPU reference).
+    /// (`instances.len() × segments`), all in one parallel pass (CPU reference), the wind
+    /// blowing since t = 0.
     pub fn rotations_instances(
         &self,
         tree: &Tree,
@@ -227,7 +252,20 @@ impl Zioma {
         t: f32,
         instances: &[ZiomaInstance],
     ) -> Vec<[f32; 4]> {
-        let frames = self.frames_for(fields, waves, t, instances);
+        self.rotations_instances_ringing(tree, fields, waves, t, instances, &self.start_ring(fields, waves))
+    }
+
+    /// [`Self::rotations_instances`] ringing by `ring`.
+    pub fn rotations_instances_ringing(
+        &self,
+        tree: &Tree,
+        fields: &[RawField],
+        waves: &[RawWave],
+        t: f32,
+        instances: &[ZiomaInstance],
+        ring: &Ring,
+    ) -> Vec<[f32; 4]> {
+        let frames = self.frames_for(fields, waves, t, instances, ring);
         let mut out = vec![[0.0; 4]; tree.segments.len() * instances.len()];
         zioma_rotations(fields, waves, &self.raw, &self.stems, &frames, &mut out);
         out
@@ -239,15 +277,37 @@ impl Zioma {
         self.rotations_packed(tree, &fields, &waves, t)
     }
 
-    /// [`Self::rotations`] with a scene packed once by the caller.
+    /// [`Self::rotations`] with a scene packed once by the caller (blowing since t = 0).
     pub fn rotations_packed(&self, tree: &Tree, fields: &[RawField], waves: &[RawWave], t: f32) -> Vec<[f32; 4]> {
-        let frame = self.frame(fields, waves, t);
+        self.rotations_ringing(tree, fields, waves, t, &self.start_ring(fields, waves))
+    }
+
+    /// Per-segment rotations δ at time `t` ringing by `ring`.
+    pub fn rotations_ringing(
+        &self,
+        tree: &Tree,
+        fields: &[RawField],
+        waves: &[RawWave],
+        t: f32,
+        ring: &Ring,
+    ) -> Vec<[f32; 4]> {
+        let frame = self.frame(fields, waves, t, ring);
         let mut out = vec![[0.0; 4]; tree.segments.len()];
         zioma_rotations(fields, waves, &self.raw, &self.stems, &[frame], &mut out);
         out
     }
 
-    /// The pose at time `t` (CPU reference).
+    /// The state's ring in `wind`: its own if the last step took that wind, else the ring of a
+    /// change to it now.
+    fn current_ring(&self, state: &ZiomaState, wind: &PackedWind) -> Ring {
+        match &state.wind {
+            Some(w) if w == wind => state.ring,
+            Some(w) => self.ring_after(w, wind, &state.ring, state.time),
+            None => self.ring_after(&PackedWind::calm(), wind, &state.ring, state.time),
+        }
+    }
+
+    /// The pose at time `t` (CPU reference, the wind blowing since t = 0).
     pub fn pose_at(&self, tree: &Tree, wind: &PackedWind, t: f32) -> Pose {
         Pose::from_rotations(tree, &self.rotations_packed(tree, &wind.fields, &wind.waves, t))
     }
@@ -264,7 +324,12 @@ impl Method for Zioma {
         ZiomaState::default()
     }
 
-    fn step(&self, _tree: &Tree, _wind: &PackedWind, state: &mut ZiomaState, dt: f32) {
+    /// Advances the time; a wind unlike the last step's starts a ring at the current time.
+    fn step(&self, _tree: &Tree, wind: &PackedWind, state: &mut ZiomaState, dt: f32) {
+        if state.wind.as_ref() != Some(wind) {
+            state.ring = self.current_ring(state, wind);
+            state.wind = Some(wind.clone());
+        }
         state.time += dt;
     }
 
@@ -277,11 +342,14 @@ impl Method for Zioma {
     }
 
     fn seam(&self, tree: &Tree, wind: &PackedWind, state: &ZiomaState, out: &mut SeamPose) {
-        *out = SeamPose::from_rotations(tree, &self.rotations_packed(tree, &wind.fields, &wind.waves, state.time));
+        let ring = self.current_ring(state, wind);
+        *out =
+            SeamPose::from_rotations(tree, &self.rotations_ringing(tree, &wind.fields, &wind.waves, state.time, &ring));
     }
 
     fn pose(&self, tree: &Tree, wind: &PackedWind, state: &ZiomaState) -> Pose {
-        self.pose_at(tree, wind, state.time)
+        let ring = self.current_ring(state, wind);
+        Pose::from_rotations(tree, &self.rotations_ringing(tree, &wind.fields, &wind.waves, state.time, &ring))
     }
 
     fn seam_instances(
@@ -292,7 +360,8 @@ impl Method for Zioma {
         instances: &[Placement],
         out: &mut SeamPose,
     ) -> bool {
-        let delta = self.rotations_instances(tree, &wind.fields, &wind.waves, state.time, instances);
+        let ring = self.current_ring(state, wind);
+        let delta = self.rotations_instances_ringing(tree, &wind.fields, &wind.waves, state.time, instances, &ring);
         *out = SeamPose::from_rotations(tree, &delta);
         true
     }

@@ -19,8 +19,11 @@
 //!   drag on the moving crown at its centre of pressure, so it rises with the wind.
 //!
 //! Fields without waves (constant, gust front, vortex, blast) pass through unfiltered
-//! (quasi-statically): a tree does not ring after a gust front or when the wind stops, which
-//! would need state. Small-branch chaos rides on top as noise bands (multiples of f₀, scaled
+//! (quasi-statically). When the wind itself changes (it starts, stops, is swapped or
+//! edited), the one piece of state, a [`Ring`], takes over: the trunk's bend and rate are
+//! kept continuous across the change, and the difference between the old wind's answer
+//! and the new one's rings down as the free oscillator, `e^{−ζω₀τ}(X cos ω_d τ + …)`, still
+//! a closed form in t. Small-branch chaos rides on top as noise bands (multiples of f₀, scaled
 //! by θ): parallel (2.3 f₀, 0.12 θ; 5.1 f₀, 0.05 θ), perpendicular (3.1 f₀, 0.06 θ) and a
 //! twist (1.3 f₀, 0.08 θ). A heavier, stiffer tree gets a lower f₀ and a smaller θ: lower
 //! amplitude and frequency, as in Fig. 6-3.
@@ -167,6 +170,66 @@ impl TrunkModel {
         let swing = through - raw;
         let theta = self.static_bend(u);
         along * (theta + self.static_bend_slope(u) * swing.dot(along)) + across * (theta * swing.dot(across) / u)
+    }
+}
+
+/// The trunk's free ring-down since the wind last changed: the bend (a horizontal lean
+/// vector in the scene's frame, rad, as [`TrunkModel::bend`]) and its rate the closed form
+/// lacked at the change, which then decay as the free oscillator at f₀ with the damping
+/// ratio of the new wind. Zero (the default): no ring.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Ring {
+    /// Bend at the change, rad.
+    pub bend: Vec3,
+    /// Rate of bend at the change, rad/s.
+    pub rate: Vec3,
+    /// Time of the change, s.
+    pub since: f32,
+    /// Damping ratio in the new wind.
+    pub zeta: f32,
+}
+
+/// Half-width of the central difference a bend's rate is taken over, s.
+const RATE_DT: f32 = 0.01;
+
+impl TrunkModel {
+    /// The ring's bend and rate at time `t` (none before its change).
+    pub fn ring_at(&self, ring: &Ring, t: f32) -> (Vec3, Vec3) {
+        let tau = t - ring.since;
+        if tau < 0.0 || (ring.bend == Vec3::ZERO && ring.rate == Vec3::ZERO) {
+            return (Vec3::ZERO, Vec3::ZERO);
+        }
+        let w = std::f32::consts::TAU * self.natural_frequency;
+        let z = ring.zeta.clamp(0.0, 0.95);
+        let (a, wd) = (z * w, w * (1.0 - z * z).sqrt());
+        let (sin, cos) = (wd * tau).sin_cos();
+        let decay = (-a * tau).exp();
+        let b = (ring.rate + ring.bend * a) / wd;
+        (decay * (ring.bend * cos + b * sin), decay * (ring.rate * cos - (ring.bend * wd + b * a) * sin))
+    }
+
+    /// The trunk's bend at `p` and time `t` in a wind (the closed form) with `ring` on top,
+    /// and its rate.
+    fn bend_and_rate(&self, wind: (&[RawField], &[RawWave]), ring: &Ring, p: Vec3, t: f32) -> (Vec3, Vec3) {
+        let bend = |t| self.bend(wind.0, wind.1, p, t);
+        let (x, v) = self.ring_at(ring, t);
+        (bend(t) + x, (bend(t + RATE_DT) - bend(t - RATE_DT)) / (2.0 * RATE_DT) + v)
+    }
+
+    /// The ring that keeps the trunk's bend at `p` and its rate continuous when the wind
+    /// changes from `old` (ringing by `ring`) to `new` at time `t`.
+    pub fn ring_after(
+        &self,
+        old: (&[RawField], &[RawWave]),
+        new: (&[RawField], &[RawWave]),
+        ring: &Ring,
+        p: Vec3,
+        t: f32,
+    ) -> Ring {
+        let (x0, v0) = self.bend_and_rate(old, ring, p, t);
+        let (x1, v1) = self.bend_and_rate(new, &Ring::default(), p, t);
+        let u = crate::wind::sample::wind_at(new.0, new.1, p, t);
+        Ring { bend: x0 - x1, rate: v0 - v1, since: t, zeta: self.damping(Vec3::new(u.x, 0.0, u.z).length()) }
     }
 }
 

@@ -49,6 +49,7 @@ struct HsmStep {
     clusters: u32,
     particles: u32,
     max_children: u32,
+    hold: f32,
 }
 
 // Rotation matrix of a unit quaternion (as glam's Mat3::from_quat).
@@ -135,8 +136,8 @@ fn rotation_step(r: mat3x3<f32>, a: mat3x3<f32>, eps: f32) -> vec3<f32> {
 // to twice this; NEWTON_NEAR on the CPU).
 const NEWTON_NEAR: f32 = 0.05;
 
-// Largest weight a cluster brings to the mean of its particles' goals: k h², past 1 only up
-// to the path's k̂ h² (aqq_inv[0].w); a particle's step min(1, Σ w) is clamped, the weights
+// Largest weight a cluster brings to the mean of its particles' goals: k h², past the hold only up
+// to the path's k̂ h² (aqq_inv[0].w); a particle's step min(Σ w, hold) is clamped, the weights
 // are not (MAX_WEIGHT on the CPU).
 const MAX_WEIGHT: f32 = 1e6;
 
@@ -148,12 +149,12 @@ fn hsm_goal_displacement(st: HsmClusterState, q: vec3<f32>) -> vec3<f32> {
     return (tq - q) + shift;
 }
 
-// A free particle's new velocity: pull toward goal g (w = ᾱ) from u (both displacements
+// A free particle's new velocity: pull toward goal g (w = Σw, ᾱ = min(Σw, hold)) from u (both displacements
 // from rest), gravity, semi-implicit drag toward `wind` with drag factor kd, damping.
 // Twin: particle_velocity.
 fn hsm_velocity(v: vec3<f32>, g: vec4<f32>, u: vec3<f32>, wind: vec3<f32>, kd: f32, step: HsmStep) -> vec3<f32> {
     let h = step.dt;
-    var vel = v + (g.xyz - u) * (g.w * (1.0 / h)) + step.gravity.xyz * ((1.0 - step.gravity.w) * h);
+    var vel = v + (g.xyz - u) * (min(g.w, step.hold) * (1.0 / h)) + step.gravity.xyz * ((1.0 - step.gravity.w) * h);
     let rel = wind - vel;
     let s = h * kd * length(rel);
     vel += rel * (s / (1.0 + s));

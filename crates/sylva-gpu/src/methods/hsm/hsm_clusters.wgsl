@@ -84,7 +84,7 @@ fn main(
         }
     }
     // The cluster's weight k h², past 1 only up to its path's k̂ h² (see MAX_WEIGHT).
-    let bound = max(cl.aqq_inv[0].w * step.dt * step.dt, 1.0);
+    let bound = max(cl.aqq_inv[0].w * step.dt * step.dt, step.hold);
     let weight = min(min(cl.rest_cm.w * step.dt * step.dt, bound), MAX_WEIGHT);
     var u = vec3<f32>(0.0);
     if (inf.kind != HSM_LEAF) {

@@ -1,5 +1,5 @@
 // Stage 3's gather, shared by hsm_goals and hsm_particles: a particle's goal as a
-// displacement from rest (xyz) and ᾱ = min(1, Σw) (w), the mean of its clusters' goals
+// displacement from rest (xyz) and Σw (w; ᾱ = min(Σw, hold) in hsm_velocity), the mean of its clusters' goals
 // weighted by their w = k h² (not clamped at 1, see MAX_WEIGHT), in cluster order. Binds
 // group 0, bindings 0 member offsets, 1 members, 2 cluster state. Twin: particle_goal in
 // sylva_core::methods::hsm::kernels.
@@ -18,7 +18,7 @@ fn hsm_particle_goal(i: u32) -> vec4<f32> {
         wsum += st.cm.w;
     }
     if (wsum > 0.0) {
-        return vec4<f32>(sum / wsum, min(wsum, 1.0));
+        return vec4<f32>(sum / wsum, wsum);
     }
     return vec4<f32>(0.0);
 }

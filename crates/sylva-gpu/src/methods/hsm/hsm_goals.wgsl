@@ -1,4 +1,4 @@
-// hsm_goals (Song §5.2 stage 3), per particle: its goal (a displacement from rest) and ᾱ
+// hsm_goals (Song §5.2 stage 3), per particle: its goal (a displacement from rest) and Σw
 // from `hsm_particle_goal` (hsm_gather.wgsl). CPU twin: sylva_core::methods::hsm::kernels::hsm_goals.
 // Bindings: 0 member offsets, 1 members, 2 cluster state (from hsm_gather.wgsl), 3 goals.
 

@@ -138,7 +138,7 @@ impl GpuHsm {
     /// the end (not waited for).
     pub fn advance_steps(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
         let method = self.method.clone();
-        let n = method.params.substeps.max(1) as usize;
+        let n = method.substeps(dt) as usize;
         let h = dt / n as f32;
         let total = steps * n;
         let mut done = 0;

@@ -11,7 +11,7 @@ use crate::{GpuContext, GpuError};
 use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::methods::MethodOptions;
-use sylva_core::methods::zioma::{RawZiomaFrame, Zioma, ZiomaParams};
+use sylva_core::methods::zioma::{RawZiomaFrame, Ring, Zioma, ZiomaParams};
 use sylva_core::pose::{Placement, Pose};
 
 /// Zioma's method on the GPU for one tree and its placed instances.
@@ -26,6 +26,8 @@ pub struct GpuZioma {
     stems: wgpu::Buffer,
     frame: wgpu::Buffer,
     instances: Vec<Placement>,
+    /// The trunk's ring-down since the wind last changed (as the CPU's state).
+    ring: Ring,
     /// Time of the pose, s.
     pub time: f32,
 }
@@ -48,7 +50,9 @@ impl GpuZioma {
     ) -> Result<Self, GpuError> {
         let count = instances.len().max(1);
         let zeroed: RawZiomaFrame = bytemuck::Zeroable::zeroed();
+        let ring = method.start_ring(&wind.packed.fields, &wind.packed.waves);
         Ok(Self {
+            ring,
             kernel: Kernel::get(ctx, "zioma_rotations"),
             pose: GpuPose::with_instances(ctx, &tree, count)?,
             wind: wind.clone(),
@@ -74,9 +78,9 @@ impl GpuZioma {
         self.time = t;
         let (m, w) = (&self.method, &*self.wind.packed);
         let frames: Vec<RawZiomaFrame> = if self.instances.is_empty() {
-            vec![m.frame(&w.fields, &w.waves, t)]
+            vec![m.frame(&w.fields, &w.waves, t, &self.ring)]
         } else {
-            m.frames_for(&w.fields, &w.waves, t, &self.instances)
+            m.frames_for(&w.fields, &w.waves, t, &self.instances, &self.ring)
         };
         ctx.queue.write_buffer(&self.frame, 0, bytemuck::cast_slice(&frames));
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -125,7 +129,11 @@ impl GpuAnimator for GpuZioma {
     fn tree(&self) -> &Arc<Tree> {
         &self.tree
     }
+    /// A wind unlike the last starts a ring at the current time, as on the CPU.
     fn set_wind(&mut self, wind: &GpuWind) {
+        if *wind.packed != *self.wind.packed {
+            self.ring = self.method.ring_after(&self.wind.packed, &wind.packed, &self.ring, self.time);
+        }
         self.wind = wind.clone();
     }
     fn reset(&mut self, _ctx: &GpuContext, time: f32) {
