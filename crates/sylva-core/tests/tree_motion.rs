@@ -12,7 +12,9 @@ use sylva_core::methods::akagi::{Akagi, AkagiParams};
 use sylva_core::methods::hsm::{Hsm, HsmParams};
 use sylva_core::methods::skjermo::{Skjermo, SkjermoParams};
 use sylva_core::methods::zioma::{Zioma, ZiomaParams};
-use sylva_core::physics::measure::{damping_ratio, linear_fit, ringdown_frequency};
+use sylva_core::physics::measure::{
+    damping_ratio, linear_fit, ringdown_frequency, tip_from_attachment, variance_above,
+};
 use sylva_core::physics::stem_frequencies;
 use sylva_core::pose::Pose;
 use sylva_core::species::{PRESETS, PresetKind, SpeciesSource};
@@ -178,21 +180,6 @@ fn damping_is_in_the_field_range_and_rises_with_wind<M: Method>(name: &str, floo
 
 /// Standard deviation of the trunk top's horizontal motion in the `gusty` preset (6 m/s
 /// mean) over a minute, as a fraction of the aspen's height (12 m).
-fn gusty_sway<M: Method>(m: impl Fn(&Tree) -> M) -> f32 {
-    let t = species("quaking_aspen", 1.0, 1);
-    let a = m(&t);
-    let wind = WindScene::resolve("gusty").unwrap().packed();
-    let top = trunk_top(&t);
-    let mut s = a.rest_state(&t);
-    let dt = 1.0 / 60.0;
-    let d = record(&a, &t, &mut s, &wind, dt, 3600, |p| p.end(&t, top));
-    let tail = &d[600..];
-    let mean = tail.iter().copied().sum::<Vec3>() / tail.len() as f32;
-    let var =
-        tail.iter().map(|p| ((*p - mean) * Vec3::new(1.0, 0.0, 1.0)).length_squared()).sum::<f32>() / tail.len() as f32;
-    var.sqrt() / t.height()
-}
-
 #[test]
 fn akagi_sways_a_uniform_cantilever_at_the_beam_formula() {
     sways_a_cantilever_at_the_beam_formula("akagi", |t| Akagi::new(t, AkagiParams::default()));
@@ -257,22 +244,102 @@ fn hsm_damping_is_in_the_field_range_and_rises_with_wind() {
     damping_is_in_the_field_range_and_rises_with_wind("hsm", 0.05, hsm);
 }
 
+/// One method's minute in the `gusty` preset on the aspen (12 m), the first 10 s not read.
+struct Gusty {
+    /// Standard deviation of the trunk top's horizontal motion, fraction of the height.
+    sway: f32,
+    /// Share of the variance of the trunk top's motion above 1.5 Hz.
+    trunk_above: f32,
+    /// Share of the variance of second-level tips' motion relative to their attachment (in
+    /// the parent segment's frame, [`tip_from_attachment`]) above 1.5 Hz, pooled over the
+    /// tips.
+    twigs_above: f32,
+}
+
+fn gusty<M: Method>(m: impl Fn(&Tree) -> M) -> Gusty {
+    let t = species("quaking_aspen", 1.0, 1);
+    let a = m(&t);
+    let wind = WindScene::resolve("gusty").unwrap().packed();
+    let top = trunk_top(&t);
+    let st = &t.stems;
+    let tips: Vec<usize> = (0..st.len())
+        .filter(|&k| st.segment_count[k] > 0 && t.segments.level[st.first_segment[k] as usize] == 2)
+        .collect();
+    let dt = 1.0 / 60.0;
+    let mut s = a.rest_state(&t);
+    let mut trunk = Vec::new();
+    let mut twigs: Vec<Vec<Vec3>> = vec![Vec::new(); tips.len()];
+    for _ in 0..3600 {
+        a.step(&t, &wind, &mut s, dt);
+        let p = a.pose(&t, &wind, &s);
+        trunk.push(p.end(&t, top));
+        for (series, &k) in twigs.iter_mut().zip(&tips) {
+            series.push(tip_from_attachment(&t, &p, k));
+        }
+    }
+    let tail = &trunk[600..];
+    let mean = tail.iter().copied().sum::<Vec3>() / tail.len() as f32;
+    let var =
+        tail.iter().map(|p| ((*p - mean) * Vec3::new(1.0, 0.0, 1.0)).length_squared()).sum::<f32>() / tail.len() as f32;
+    let above = |series: &[Vec<Vec3>]| {
+        let (mut hi, mut all) = (0.0, 0.0);
+        for s in series {
+            for c in 0..3 {
+                let x: Vec<f32> = s[600..].iter().map(|v| v[c]).collect();
+                let (h, a) = variance_above(&x, dt, 1.5);
+                hi += h;
+                all += a;
+            }
+        }
+        hi / all
+    };
+    Gusty { sway: var.sqrt() / t.height(), trunk_above: above(&[trunk]), twigs_above: above(&twigs) }
+}
+
+/// The four methods' gusty minutes, run once for the tests that read them.
+fn gusty_runs() -> &'static [(&'static str, Gusty); 4] {
+    static RUNS: std::sync::OnceLock<[(&str, Gusty); 4]> = std::sync::OnceLock::new();
+    RUNS.get_or_init(|| {
+        [
+            ("zioma", gusty(|t| Zioma::new(t, ZiomaParams::default()))),
+            ("akagi", gusty(|t| Akagi::new(t, AkagiParams::default()))),
+            ("skjermo", gusty(|t| Skjermo::new(t, SkjermoParams::default()))),
+            ("hsm", gusty(hsm)),
+        ]
+    })
+}
+
 /// Trunk-top sway in `gusty` lies in the field range under every method, and the four agree
 /// within 2× on the same tree.
 #[test]
 fn every_method_sways_half_to_three_percent_of_the_height_in_a_moderate_breeze_within_2x() {
-    let sways = [
-        ("zioma", gusty_sway(|t| Zioma::new(t, ZiomaParams::default()))),
-        ("akagi", gusty_sway(|t| Akagi::new(t, AkagiParams::default()))),
-        ("skjermo", gusty_sway(|t| Skjermo::new(t, SkjermoParams::default()))),
-        ("hsm", gusty_sway(hsm)),
-    ];
+    let sways = gusty_runs().each_ref().map(|(n, g)| (*n, g.sway));
     println!("aspen trunk-top sway, % of height: {:?}", sways.map(|(n, x)| (n, 100.0 * x)));
     for (name, x) in sways {
         assert!((0.005..=0.03).contains(&x), "{name}: sway {} % of height", 100.0 * x);
     }
     let (lo, hi) = sways.iter().fold((f32::MAX, 0.0f32), |(lo, hi), (_, x)| (lo.min(*x), hi.max(*x)));
     assert!(hi / lo <= 2.0, "not within 2×: {sways:?}");
+}
+
+/// Branches have frequencies of their own above the trunk's: in `gusty` (whose band of the
+/// crown's own eddies reaches 8 Hz), the share of second-level tips' motion relative to their
+/// attachment that lies above 1.5 Hz is at least ten times the trunk top's in every method,
+/// and at least 10 % (the field goal) in Zioma. Akagi, Skjermo and HSM fall short of 10 % on
+/// this 12 m aspen: the pooled variance is led by the long end twigs that carry 25 leaves on
+/// a 1.5 mm section, which the leaves' drag damps past critical (see FIDELITY.md).
+#[test]
+fn second_level_tips_move_faster_than_the_trunk_in_gusty_wind() {
+    let mut failures = Vec::new();
+    for (name, g) in gusty_runs() {
+        let (trunk, twigs) = (100.0 * g.trunk_above, 100.0 * g.twigs_above);
+        println!("{name:8} above 1.5 Hz: trunk top {trunk:.2} %, level-2 tips {twigs:.1} %");
+        let floor = if *name == "zioma" { 10.0f32.max(10.0 * trunk) } else { 10.0 * trunk };
+        if twigs < floor {
+            failures.push(format!("{name}: level-2 tips {twigs:.1} % above 1.5 Hz (trunk top {trunk:.2} %)"));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
 }
 
 /// 5 m/s with a 0.5 m/s sine of `f` Hz travelling with it.

@@ -447,17 +447,35 @@ fn gusty_wind_gusts_travel_downwind_from_probe_to_probe() {
     assert!((lag_s - 2.0).abs() < 1.0, "lag {lag_s:.2} s, expected about 2 s (12 m at 6 m/s)");
 }
 
-/// The `gusty` preset's turbulence (64 waves) has the spectrum it asks for, β = 5/3 within
-/// ±0.1.
+/// The `gusty` preset's atmospheric turbulence (48 waves, 0.01–1.5 Hz) has the spectrum it
+/// asks for, β = 5/3 within ±0.1; its crown band (16 waves, 1.5–8 Hz, too few per 0.1 decade
+/// for a slope) puts its rms above 1.5 Hz and none of it below, within 5 %.
 #[test]
 fn gusty_turbulence_has_the_configured_spectral_slope() {
     let scene = WindScene::resolve("gusty").unwrap();
-    let Some(WindField::Turbulence(t)) = scene.fields.iter().find(|f| matches!(f, WindField::Turbulence(_))) else {
-        panic!("gusty has turbulence");
-    };
-    let slope = spectral_slope_of(t.clone(), 0.03, 3.0);
-    println!("gusty turbulence: fitted slope {slope:.3}, configured −{:.3}", t.beta);
-    assert!((slope + t.beta as f64).abs() < 0.1, "slope {slope}, β {}", t.beta);
+    let bands: Vec<&Turbulence> =
+        scene.fields.iter().filter_map(|f| if let WindField::Turbulence(t) = f { Some(t) } else { None }).collect();
+    let [air, crown] = bands[..] else { panic!("gusty has the atmosphere's and the crown's turbulence") };
+    let slope = spectral_slope_of(air.clone(), 0.03, air.f_max as f64 / 1.15);
+    println!("gusty turbulence: fitted slope {slope:.3}, configured −{:.3}", air.beta);
+    assert!((slope + air.beta as f64).abs() < 0.1, "slope {slope}, β {}", air.beta);
+    let (fields, waves) = one(WindField::Turbulence(crown.clone())).pack();
+    let dt = 0.01f32;
+    let v: Vec<Vec3> = (0..60_000)
+        .map(|i| sylva_core::wind::sample::wind_at(&fields, &waves, Vec3::new(3.0, 10.0, -7.0), i as f32 * dt))
+        .collect();
+    let x: Vec<f32> = v.iter().map(|v| v.x).collect();
+    let (above, all) = sylva_core::physics::measure::variance_above(&x, dt, crown.f_min);
+    // Each horizontal component's rms, as configured: the mean of the two.
+    let rms = (v.iter().map(|v| v.x * v.x + v.z * v.z).sum::<f32>() / (2 * v.len()) as f32).sqrt();
+    println!(
+        "gusty crown band: rms {rms:.3} m/s (configured {}), {:.1} % above {} Hz",
+        crown.intensity,
+        100.0 * above / all,
+        crown.f_min
+    );
+    assert!((rms / crown.intensity - 1.0).abs() < 0.05, "rms {rms}");
+    assert!(above / all > 0.95, "{}", above / all);
 }
 
 /// The packed envelope of a wave field: exactly 1 without fades (so a scene without them

@@ -9,7 +9,8 @@
 //!   top, % of height) and the damping ratio of the ringing about it;
 //! - **gusty** (the `gusty` preset, 6 m/s mean): the trunk top's sway (standard deviation of
 //!   its horizontal motion, % of height) and, per stem level, the share of the tips' motion
-//!   relative to where their stem attaches that lies above 1.5 Hz (flutter).
+//!   relative to their attachment, in the frame of the segment they grow from (the parent's
+//!   own sway taken out), that lies above 1.5 Hz (flutter).
 //!
 //! References ([`runs::FIELD`]): 0.2–1 Hz for 10–30 m trees and frequency linear in DBH/H²
 //! (Moore & Maguire 2004, 602 trees); damping ratios 0.02–0.2 rising with wind; trunk-top

@@ -3,11 +3,10 @@
 
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
-use rustfft::{FftPlanner, num_complex::Complex};
 use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::methods::{Animator, MethodOptions};
-use sylva_core::physics::measure::{damping_ratio, ringdown_frequency};
+use sylva_core::physics::measure::{damping_ratio, ringdown_frequency, tip_from_attachment, variance_above};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::{Constant, WindField, WindScene};
 
@@ -74,7 +73,8 @@ pub struct Row {
     /// Standard deviation of the trunk top's horizontal motion in gusty wind, % of height.
     pub sway_percent: f32,
     /// Per stem level 0, 1, 2: share of the variance of the tips' motion relative to their
-    /// stem's base that lies above 1.5 Hz (None: no stems at that level).
+    /// attachment ([`tip_from_attachment`]) that lies above 1.5 Hz (None: no stems at that
+    /// level).
     pub flutter: [Option<f32>; 3],
 }
 
@@ -111,23 +111,6 @@ fn record<T>(
             probe(&anim.pose())
         })
         .collect()
-}
-
-/// Share of a series' variance above `f` Hz.
-fn share_above(series: &[f32], dt: f32, f: f32) -> (f32, f32) {
-    let n = series.len();
-    let mean = series.iter().sum::<f32>() / n.max(1) as f32;
-    let mut buf: Vec<Complex<f32>> = series.iter().map(|&x| Complex::new(x - mean, 0.0)).collect();
-    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
-    let df = 1.0 / (n as f32 * dt);
-    let (mut hi, mut all) = (0.0, 0.0);
-    for (k, c) in buf.iter().enumerate().take(n / 2).skip(1) {
-        all += c.norm_sqr();
-        if k as f32 * df > f {
-            hi += c.norm_sqr();
-        }
-    }
-    (hi, all)
 }
 
 /// Runs the pluck, the step responses and the gusts of `method` on `tree`.
@@ -170,18 +153,16 @@ pub fn measure(
             damping: damping_ratio(&x, lean, 0.05 * peak),
         });
     }
-    // Gusts: the trunk top, and the tips of each level relative to their stem's base.
+    // Gusts: the trunk top, and the tips of each level relative to their attachment.
     let st = &t.stems;
     let level_of = |k: usize| t.segments.level[st.first_segment[k] as usize] as usize;
-    let tips: Vec<(usize, usize, usize)> = (0..st.len())
-        .filter(|&k| level_of(k) <= 2 && st.segment_count[k] > 0)
-        .map(|k| (level_of(k), st.first_segment[k] as usize, (st.first_segment[k] + st.segment_count[k] - 1) as usize))
-        .collect();
+    let tips: Vec<(usize, usize)> =
+        (0..st.len()).filter(|&k| level_of(k) <= 2 && st.segment_count[k] > 0).map(|k| (level_of(k), k)).collect();
     anim.set_wind(Arc::new(WindScene::resolve("gusty")?.packed()));
     anim.reset(0.0);
     let samples = record(&mut *anim, dt, p.gusty, |pose| {
         let mut v = vec![pose.end(t, top)];
-        v.extend(tips.iter().map(|&(_, base, tip)| pose.end(t, tip) - pose.start[base]));
+        v.extend(tips.iter().map(|&(_, k)| tip_from_attachment(t, pose, k)));
         v
     });
     let skip = ((10.0 / dt) as usize).min(samples.len() / 2);
@@ -190,10 +171,10 @@ pub fn measure(
     let mean = samples.iter().map(|s| s[0]).sum::<Vec3>() / n;
     let var = samples.iter().map(|s| ((s[0] - mean) * Vec3::new(1.0, 0.0, 1.0)).length_squared()).sum::<f32>() / n;
     let mut flutter = [(0.0f32, 0.0f32); 3];
-    for (j, &(level, _, _)) in tips.iter().enumerate() {
+    for (j, &(level, _)) in tips.iter().enumerate() {
         for c in 0..3 {
             let series: Vec<f32> = samples.iter().map(|s| s[j + 1][c]).collect();
-            let (hi, all) = share_above(&series, dt, 1.5);
+            let (hi, all) = variance_above(&series, dt, 1.5);
             flutter[level].0 += hi;
             flutter[level].1 += all;
         }

@@ -1,6 +1,12 @@
 //! Reading a tree's motion the way field studies do: sway frequency from zero crossings,
-//! damping ratio from the logarithmic decrement of successive peaks, and least-squares lines
-//! (frequency against DBH/H²).
+//! damping ratio from the logarithmic decrement of successive peaks, least-squares lines
+//! (frequency against DBH/H²), and how much of a branch's own motion is fast (flutter).
+
+use crate::Tree;
+use crate::model::NONE;
+use crate::pose::Pose;
+use glam::{Quat, Vec3};
+use rustfft::{FftPlanner, num_complex::Complex};
 
 /// Frequency of an oscillating series sampled every `dt` s, Hz: upward crossings of its mean
 /// over the span between the first and the last. `None` with fewer than three crossings.
@@ -78,6 +84,41 @@ pub fn linear_fit(points: &[(f64, f64)]) -> (f64, f64, f64) {
     (slope, my - slope * mx, r2)
 }
 
+/// Where stem `stem`'s tip lies relative to its attachment, m: the offset from the stem's base
+/// to its tip, in the frame of the segment it grows from (turned back by that segment's turn
+/// from rest), so the parent's own sway is taken out and what remains is the stem's own
+/// motion. The trunk's offset is in the world frame.
+pub fn tip_from_attachment(tree: &Tree, pose: &Pose, stem: usize) -> Vec3 {
+    let s = &tree.stems;
+    let base = s.first_segment[stem] as usize;
+    let tip = base + s.segment_count[stem].max(1) as usize - 1;
+    let parent = tree.segments.parent[base];
+    let turn = if parent == NONE {
+        Quat::IDENTITY
+    } else {
+        pose.orientation[parent as usize] * tree.segments.orientation[parent as usize].inverse()
+    };
+    turn.inverse() * (pose.end(tree, tip) - pose.start[base])
+}
+
+/// A series' variance above `f` Hz and in all (its mean removed; periodogram of the whole
+/// series sampled every `dt` s), in the series' units squared times its length.
+pub fn variance_above(series: &[f32], dt: f32, f: f32) -> (f32, f32) {
+    let n = series.len();
+    let mean = series.iter().sum::<f32>() / n.max(1) as f32;
+    let mut buf: Vec<Complex<f32>> = series.iter().map(|&x| Complex::new(x - mean, 0.0)).collect();
+    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
+    let df = 1.0 / (n as f32 * dt);
+    let (mut hi, mut all) = (0.0, 0.0);
+    for (k, c) in buf.iter().enumerate().take(n / 2).skip(1) {
+        all += c.norm_sqr();
+        if k as f32 * df > f {
+            hi += c.norm_sqr();
+        }
+    }
+    (hi, all)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -109,5 +150,57 @@ mod tests {
         assert_eq!(damping_ratio(&driven, 0.0, 0.01), None);
         let (slope, icpt, r2) = linear_fit(&[(0.0, 1.0), (1.0, 3.0), (2.0, 5.0)]);
         assert!((slope - 2.0).abs() < 1e-12 && (icpt - 1.0).abs() < 1e-12 && (r2 - 1.0).abs() < 1e-12);
+    }
+
+    /// Two sines, of 0.5 and 3 Hz with variances 1 and ¼: a fifth of the variance lies above
+    /// 1.5 Hz.
+    #[test]
+    fn variance_above_splits_two_sines_by_their_power() {
+        let dt = 1.0 / 60.0;
+        let x: Vec<f32> = (0..3600)
+            .map(|k| k as f32 * dt)
+            .map(|t| {
+                2f32.sqrt() * (std::f32::consts::TAU * 0.5 * t).sin()
+                    + 0.5 * 2f32.sqrt() * (std::f32::consts::TAU * 3.0 * t).cos()
+            })
+            .collect();
+        let (hi, all) = variance_above(&x, dt, 1.5);
+        assert!((hi / all - 0.2).abs() < 1e-3, "{}", hi / all);
+        let (none, _) = variance_above(&x, dt, 4.0);
+        assert!(none / all < 1e-6);
+    }
+
+    /// A branch carried by its parent's turn stays put in the parent's frame; bending the
+    /// branch itself moves its tip there.
+    #[test]
+    fn a_tip_turned_with_its_parent_stays_put_in_the_parent_s_frame() {
+        let tree = crate::species::SpeciesSource::resolve("quaking_aspen")
+            .unwrap()
+            .generate(1, &Default::default(), None)
+            .unwrap();
+        let stem = (0..tree.stems.len()).find(|&k| tree.stems.parent[k] != NONE).unwrap();
+        let rest = Pose::rest(&tree);
+        let at_rest = tip_from_attachment(&tree, &rest, stem);
+        // Turn the whole tree 0.3 rad about its root.
+        let q = Quat::from_rotation_z(0.3);
+        let mut turned = rest.clone();
+        for i in 0..tree.segments.len() {
+            turned.start[i] = q * rest.start[i];
+            turned.orientation[i] = q * rest.orientation[i];
+        }
+        let carried = tip_from_attachment(&tree, &turned, stem);
+        assert!((carried - at_rest).length() < 1e-4 * at_rest.length(), "{carried} against {at_rest}");
+        // The trunk's offset is in the world frame, so it turns.
+        assert!((tip_from_attachment(&tree, &turned, 0) - q * tip_from_attachment(&tree, &rest, 0)).length() < 1e-3);
+        // Turn only the branch's segments about its base.
+        let base = tree.stems.first_segment[stem] as usize;
+        let pivot = rest.start[base];
+        let mut bent = rest.clone();
+        for i in base..base + tree.stems.segment_count[stem] as usize {
+            bent.start[i] = pivot + q * (rest.start[i] - pivot);
+            bent.orientation[i] = q * rest.orientation[i];
+        }
+        let moved = tip_from_attachment(&tree, &bent, stem);
+        assert!((moved - at_rest).length() > 0.1 * at_rest.length(), "{moved} against {at_rest}");
     }
 }
