@@ -137,7 +137,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         let mut leaves = vec![bytemuck::Zeroable::zeroed(); layout.leaf_vertex_count()];
         let mut frame = || {
             sylva_core::mesh::mesh_tubes(&info, &layout.rings, &layout.segments, &joint, &acc, &mut tubes);
-            sylva_core::mesh::mesh_leaves(&info, &layout.leaves, &layout.segments, &joint, &acc, &mut leaves);
+            sylva_core::mesh::mesh_leaves(&info, &layout.leaves, &layout.segments, &joint, &acc, &[], &mut leaves);
         };
         let (cpu_one, cpu_all) = if time_cpu {
             let one = one_thread.install(|| {

@@ -176,6 +176,8 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let levels = tree.levels as usize;
     let (mut sum_mean, mut max_disp) = (vec![0.0f64; levels], vec![0.0f32; levels]);
     let mut max_speed = 0.0f32;
+    let (mut leaf_sum2, mut leaf_count, mut leaf_max) = (0.0f64, 0u64, 0.0f32);
+    let mut seam = sylva_core::pose::SeamPose::default();
     let mut prev: Option<Vec<Vec3>> = None;
     let bar = ProgressBar::new(frames as u64);
     bar.set_style(
@@ -189,13 +191,22 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         let pose: Pose = match &mut sim {
             Sim::Cpu(m) => {
                 m.advance(dt, steps);
-                m.pose()
+                m.seam(&mut seam);
+                seam.pose(&tree, 0)
             }
             Sim::Gpu(ctx, m) => {
                 m.advance(ctx, dt, steps);
+                seam.leaf = m.pose_buffers().read_leaves(ctx)?;
                 m.read_pose(ctx)?
             }
         };
+        // Each leaf's turn relative to its segment: the angle of its rotation λ.
+        for q in &seam.leaf {
+            let a = 2.0 * q[3].abs().min(1.0).acos();
+            leaf_sum2 += (a as f64).powi(2);
+            leaf_max = leaf_max.max(a);
+        }
+        leaf_count += seam.leaf.len() as u64;
         let d = displacement(&tree, &pose);
         for l in 0..levels {
             sum_mean[l] += d.mean[l] as f64;
@@ -253,6 +264,13 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         println!("  {:>5} {:>16.4} {:>14.4}", l, sum_mean[l] / frames as f64, max_disp[l]);
     }
     println!("  largest segment-end speed {max_speed:.3} m/s");
+    if leaf_count > 0 {
+        println!(
+            "  leaves turn relative to their segments by {:.2}° RMS, {:.2}° at most",
+            (leaf_sum2 / leaf_count as f64).sqrt().to_degrees(),
+            leaf_max.to_degrees()
+        );
+    }
     Ok(())
 }
 

@@ -16,6 +16,7 @@
 //! * [`methods`]: the method seam ([`methods::Method`], [`methods::Animator`]) and one folder
 //!   per method (Zioma, Akagi, Skjermo, HSM) with its parameters, GPU-layout types, CPU
 //!   kernels and fast forms.
+//! * [`leaves`]: leaves that move about their petioles (one rotation per leaf in the seam).
 //! * [`pose`]: the seam's output (joints and accumulated rotations), forward kinematics,
 //!   placements of instances, curves for the deformer.
 //! * [`mesh`]: per-frame meshing, skinning and Skjermo's deformer, with their CPU kernels.
@@ -26,6 +27,7 @@
 pub mod export;
 pub mod generate;
 pub mod io;
+pub mod leaves;
 pub mod limits;
 pub mod mesh;
 pub mod methods;

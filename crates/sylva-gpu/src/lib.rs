@@ -19,6 +19,7 @@
 
 mod context;
 pub mod kernel;
+pub mod leaves;
 pub mod mesh;
 pub mod methods;
 pub mod pose;

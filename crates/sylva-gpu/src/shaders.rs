@@ -71,6 +71,14 @@ pub const HSM_ADVANCE: &str = include_str!("methods/hsm/hsm_advance.wgsl");
 pub const HSM_INTEGRATE: &str = include_str!("methods/hsm/hsm_integrate.wgsl");
 /// Kernel: HSM stages 3 and 4 fused, per particle.
 pub const HSM_PARTICLES: &str = include_str!("methods/hsm/hsm_particles.wgsl");
+/// Kernel: leaf rotations from HSM's leaf clusters.
+pub const HSM_LEAF_POSE: &str = include_str!("methods/hsm/hsm_leaf_pose.wgsl");
+/// Leaf motion's structs and closed form (`LeafFrame`, `LeafMotion`, `leaf_rotation`).
+pub const LEAVES: &str = include_str!("leaves/leaves.wgsl");
+/// Kernel: the wind at every twig that carries leaves.
+pub const LEAF_WIND: &str = include_str!("leaves/leaf_wind.wgsl");
+/// Kernel: every leaf's rotation about its attachment.
+pub const LEAF_FLUTTER: &str = include_str!("leaves/leaf_flutter.wgsl");
 /// Kernel: seam rotations from HSM's clusters.
 pub const HSM_POSE: &str = include_str!("methods/hsm/hsm_pose.wgsl");
 /// Per-frame meshing structs (`Ring`, `MeshInfo`, `Detail`, `Vertex`) and the bark relief.
@@ -133,6 +141,9 @@ kernels! {
     hsm_integrate: [QUAT, HSM, HSM_ADVANCE, HSM_INTEGRATE] => sylva_core::methods::hsm::kernels::hsm_integrate;
     hsm_particles: [QUAT, HSM, HSM_GATHER, HSM_ADVANCE, HSM_PARTICLES] => sylva_core::methods::hsm::kernels::hsm_particles;
     hsm_pose: [QUAT, TREE, HSM, HSM_POSE] => sylva_core::methods::hsm::kernels::hsm_pose;
+    hsm_leaf_pose: [QUAT, TREE, HSM, HSM_LEAF_POSE] => sylva_core::methods::hsm::kernels::hsm_leaf_pose;
+    leaf_wind: [QUAT, NOISE, WIND, LEAVES, LEAF_WIND] => sylva_core::leaves::kernels::leaf_wind;
+    leaf_flutter: [QUAT, NOISE, LEAVES, LEAF_FLUTTER] => sylva_core::leaves::kernels::leaf_flutter;
     mesh_tubes: [QUAT, TREE, NOISE, MESH, MESH_TUBES] => sylva_core::mesh::mesh_tubes;
     mesh_detail: [NOISE, MESH, MESH_DETAIL] => sylva_core::mesh::mesh_detail;
     mesh_leaves: [QUAT, TREE, NOISE, MESH, LEAF_SHAPE, MESH_LEAVES] => sylva_core::mesh::mesh_leaves;

@@ -160,7 +160,7 @@ fn pod_structs_match_their_wgsl_twins() {
             ("length", offset_of!(RawLeaf, length)),
             ("segment", offset_of!(RawLeaf, segment)),
             ("shape", offset_of!(RawLeaf, shape)),
-            ("_pad", offset_of!(RawLeaf, _pad)),
+            ("index", offset_of!(RawLeaf, index)),
         ],
     );
 }
@@ -202,6 +202,47 @@ fn wind_and_noise_structs_match_their_wgsl_twins() {
             ("amplitude", offset_of!(RawBand, amplitude)),
             ("bias", offset_of!(RawBand, bias)),
             ("_pad", offset_of!(RawBand, _pad)),
+        ],
+    );
+}
+
+#[test]
+fn leaf_motion_structs_match_their_wgsl_twins() {
+    use sylva_core::leaves::{RawLeafFrame, RawLeafMotion};
+    use sylva_gpu::shaders::{LEAVES, NOISE, QUAT};
+    let src = compose(&[QUAT, NOISE, LEAVES]);
+    check_in(
+        &src,
+        "LeafFrame",
+        size_of::<RawLeafFrame>(),
+        &[
+            ("time", offset_of!(RawLeafFrame, time)),
+            ("strength", offset_of!(RawLeafFrame, strength)),
+            ("flutter", offset_of!(RawLeafFrame, flutter)),
+            ("zeta", offset_of!(RawLeafFrame, zeta)),
+            ("reconfiguration_speed", offset_of!(RawLeafFrame, reconfiguration_speed)),
+            ("vogel_exponent", offset_of!(RawLeafFrame, vogel_exponent)),
+            ("leaves", offset_of!(RawLeafFrame, leaves)),
+            ("twigs", offset_of!(RawLeafFrame, twigs)),
+            ("flutter_onset", offset_of!(RawLeafFrame, flutter_onset)),
+            ("crown_wind", offset_of!(RawLeafFrame, crown_wind)),
+            ("_pad", offset_of!(RawLeafFrame, _pad)),
+        ],
+    );
+    check_in(
+        &src,
+        "LeafMotion",
+        size_of::<RawLeafMotion>(),
+        &[
+            ("orientation", offset_of!(RawLeafMotion, orientation)),
+            ("omega", offset_of!(RawLeafMotion, omega)),
+            ("omega_twist", offset_of!(RawLeafMotion, omega_twist)),
+            ("compliance", offset_of!(RawLeafMotion, compliance)),
+            ("flip_pressure", offset_of!(RawLeafMotion, flip_pressure)),
+            ("seed", offset_of!(RawLeafMotion, seed)),
+            ("twig", offset_of!(RawLeafMotion, twig)),
+            ("segment", offset_of!(RawLeafMotion, segment)),
+            ("_pad", offset_of!(RawLeafMotion, _pad)),
         ],
     );
 }

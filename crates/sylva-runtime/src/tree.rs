@@ -137,7 +137,7 @@ impl Group {
             }
             Simulation::Gpu(g) => {
                 let p = g.pose_buffers();
-                self.mesh.record(ctx, encoder, p.joints_buffer(), p.acc_buffer());
+                self.mesh.record_with_leaves(ctx, encoder, p.joints_buffer(), p.acc_buffer(), p.leaf_buffer());
                 if let (Some(d), Some(c)) = (&self.deform, g.curves()) {
                     d.record(ctx, encoder, c.stems, c.state);
                 }

@@ -9,13 +9,17 @@ use rayon::prelude::*;
 
 /// Writes leaf l's polygon `vertex[l × (leaf_sides + 1) ..][..leaf_sides + 1]`: k = 0 the
 /// centre, 1… the rim; the leaf's transform once, then the unit polygon scaled to the blade.
-/// Bindings as in the kernel: 0 info, 1 leaf, 2 segment, 3 joint, 4 acc, 5 vertex (write).
+/// The leaf turns by its rotation `λ` (`leaf_rotation[index]`, in its segment's rest frame)
+/// about its attachment; one missing from the array, or the identity, leaves it at rest.
+/// Bindings as in the kernel: 0 info, 1 leaf, 2 segment, 3 joint, 4 acc, 5 vertex (write),
+/// 6 leaf rotation.
 pub fn mesh_leaves(
     info: &RawMeshInfo,
     leaf: &[RawLeaf],
     segment: &[RawSegment],
     joint: &[[f32; 4]],
     acc: &[[f32; 4]],
+    leaf_rotation: &[[f32; 4]],
     vertex: &mut [RawVertex],
 ) {
     let stride = info.leaf_sides as usize + 1;
@@ -29,7 +33,9 @@ pub fn mesh_leaves(
         let d = Quat::from_array(acc[s]);
         let base = Vec3::new(joint[s][0], joint[s][1], joint[s][2])
             + d * (Vec3::from_array(lf.position) - Vec3::from_array(segment[s].start));
-        let q = d * Quat::from_array(lf.orientation);
+        let rest = Quat::from_array(lf.orientation);
+        let lambda = leaf_rotation.get(lf.index as usize).copied().unwrap_or([0.0, 0.0, 0.0, 1.0]);
+        let q = if lambda == [0.0, 0.0, 0.0, 1.0] { d * rest } else { d * (Quat::from_array(lambda) * rest) };
         let (qx, qy) = (q * Vec3::X, q * Vec3::Y);
         let normal = (q * Vec3::Z).to_array();
         let rim = &rims[(lf.shape as usize).min(rims.len() - 1)];

@@ -202,6 +202,9 @@ pub struct MeshLayout {
     pub segments: Vec<RawSegment>,
     /// Packed leaves.
     pub leaves: Vec<RawLeaf>,
+    /// Leaves of the tree(s) it was built from: the length of the leaf rotations it reads
+    /// ([`crate::pose::SeamPose::leaf`], indexed by [`RawLeaf::index`]).
+    pub leaf_slots: u32,
 }
 
 /// One frame's vertices.
@@ -382,6 +385,7 @@ impl MeshLayout {
             leaf_indices,
             segments: tree.raw_segments(),
             leaves: if params.leaves { tree.raw_leaves() } else { Vec::new() },
+            leaf_slots: tree.leaves.len() as u32,
         })
     }
 
@@ -404,6 +408,7 @@ impl MeshLayout {
             leaf_indices: Vec::new(),
             segments: Vec::new(),
             leaves: Vec::new(),
+            leaf_slots: 0,
         };
         for l in layouts {
             if (l.params.sides, l.params.leaf_sides) != (params.sides, params.leaf_sides) {
@@ -443,7 +448,13 @@ impl MeshLayout {
             out.tube_indices.extend(l.tube_indices.iter().map(|&i| remap(i)));
             out.leaf_indices.extend(l.leaf_indices.iter().map(|i| i + lv));
             out.segments.extend(l.segments.iter().map(|s| RawSegment { parent: shift(s.parent), ..*s }));
-            out.leaves.extend(l.leaves.iter().map(|f| RawLeaf { segment: f.segment + seg, ..*f }));
+            let slots = out.leaf_slots;
+            out.leaves.extend(l.leaves.iter().map(|f| RawLeaf {
+                segment: f.segment + seg,
+                index: f.index + slots,
+                ..*f
+            }));
+            out.leaf_slots += l.leaf_slots;
         }
         for v in [out.tube_vertex_count() as u64, out.leaf_vertex_count() as u64] {
             if v > MAX_VERTICES {
@@ -522,15 +533,21 @@ impl MeshLayout {
         self.mesh_raw(&joint, &acc)
     }
 
-    /// The mesh from the pose seam's buffers (joint positions, accumulated rotations D).
+    /// The mesh from the pose seam's buffers (joint positions, accumulated rotations D),
+    /// leaves at rest on their segments.
     pub fn mesh_raw(&self, joint: &[[f32; 4]], acc: &[[f32; 4]]) -> MeshFrame {
+        self.mesh_seam(joint, acc, &[])
+    }
+
+    /// The mesh from the pose seam's buffers with the leaves' rotations (empty: at rest).
+    pub fn mesh_seam(&self, joint: &[[f32; 4]], acc: &[[f32; 4]], leaf_rotation: &[[f32; 4]]) -> MeshFrame {
         let info = self.info();
         let mut tubes = vec![RawVertex::zeroed(); self.tube_vertex_count()];
         let ring_vertices = self.rings.len() * (self.params.sides as usize + 1);
         crate::mesh::mesh_tubes(&info, &self.rings, &self.segments, joint, acc, &mut tubes[..ring_vertices]);
         crate::mesh::mesh_detail(&info, &self.details, &mut tubes);
         let mut leaves = vec![RawVertex::zeroed(); self.leaf_vertex_count()];
-        crate::mesh::mesh_leaves(&info, &self.leaves, &self.segments, joint, acc, &mut leaves);
+        crate::mesh::mesh_leaves(&info, &self.leaves, &self.segments, joint, acc, leaf_rotation, &mut leaves);
         MeshFrame { tubes, leaves }
     }
 }

@@ -310,6 +310,7 @@ impl TreeBuilder {
             wood,
             trunk_shape: Default::default(),
             leaf_shape: Default::default(),
+            leaf_motion: Default::default(),
         };
         tree.validate()?;
         Ok(tree)

@@ -228,6 +228,8 @@ pub struct Tree {
     pub trunk_shape: TrunkShape,
     /// The outline of every leaf (Weber–Penn `LeafShape`).
     pub leaf_shape: LeafShape,
+    /// How its leaves move about their petioles.
+    pub leaf_motion: crate::leaves::LeafMotion,
 }
 
 /// The trunk's shape beyond its segments' radii (Weber–Penn `Flare`, `Lobes`, `LobeDepth`;

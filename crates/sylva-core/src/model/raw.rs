@@ -127,8 +127,9 @@ pub struct RawLeaf {
     pub segment: u32,
     /// Outline, a [`crate::model::LeafShape`] index.
     pub shape: u32,
-    /// Padding.
-    pub _pad: u32,
+    /// Its index in the tree's leaves: where its rotation is in
+    /// [`crate::pose::SeamPose::leaf`].
+    pub index: u32,
 }
 
 impl RawLeaf {
@@ -141,7 +142,7 @@ impl RawLeaf {
             length: l.length[i],
             segment: l.segment[i],
             shape: t.leaf_shape.index(),
-            _pad: 0,
+            index: i as u32,
         }
     }
 }

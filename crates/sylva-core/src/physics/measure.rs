@@ -119,6 +119,27 @@ pub fn variance_above(series: &[f32], dt: f32, f: f32) -> (f32, f32) {
     (hi, all)
 }
 
+/// Where a series' energy is: the frequency of the largest bin of its premultiplied
+/// periodogram `f S(f)`, Hz (its mean removed; sampled every `dt` s). The premultiplied form
+/// shows energy per logarithmic band, as wind and canopy spectra are read (Kaimal et al.
+/// 1972): a red spectrum's low end does not hide a resonance above it. `None` for a constant
+/// series.
+pub fn spectral_peak(series: &[f32], dt: f32) -> Option<f32> {
+    let n = series.len();
+    let mean = series.iter().sum::<f32>() / n.max(1) as f32;
+    let mut buf: Vec<Complex<f32>> = series.iter().map(|&x| Complex::new(x - mean, 0.0)).collect();
+    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
+    let df = 1.0 / (n as f32 * dt);
+    let (k, power) = buf
+        .iter()
+        .enumerate()
+        .take(n / 2)
+        .skip(1)
+        .map(|(k, c)| (k, k as f32 * c.norm_sqr()))
+        .fold((0, 0.0f32), |best, (k, p)| if p > best.1 { (k, p) } else { best });
+    (power > 0.0).then_some(k as f32 * df)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -113,6 +113,10 @@ pub struct SeamPose {
     pub joints: Vec<[f32; 4]>,
     /// Accumulated rotation `D` of every segment (x, y, z, w): orientation `D · Q_rest`.
     pub acc: Vec<[f32; 4]>,
+    /// Rotation `λ` of every leaf about its attachment, in its segment's rest frame (x, y,
+    /// z, w): the leaf's orientation is `D_s · λ · Q_leaf` ([`crate::leaves`]). Empty: every
+    /// leaf at rest on its segment.
+    pub leaf: Vec<[f32; 4]>,
 }
 
 impl SeamPose {
@@ -121,13 +125,14 @@ impl SeamPose {
         Self {
             joints: tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect(),
             acc: vec![[0.0, 0.0, 0.0, 1.0]; tree.segments.len()],
+            leaf: Vec::new(),
         }
     }
 
     /// From per-segment rotations `δ` by forward kinematics ([`seam_buffers`]).
     pub fn from_rotations(tree: &Tree, delta: &[[f32; 4]]) -> Self {
         let (joints, acc) = seam_buffers(tree, delta);
-        Self { joints, acc }
+        Self { joints, acc, leaf: Vec::new() }
     }
 
     /// Instance `k`'s pose (world orientations).

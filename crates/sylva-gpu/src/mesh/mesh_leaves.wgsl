@@ -1,6 +1,6 @@
 // mesh_leaves: one leaf per invocation (Akagi §2.4): the leaf's transform once, then its
 // polygon — k = 0 the centre, 1.. the rim (leaf_rim: the disc's two half-circles, or a
-// polygon holding the leaf's outline), scaled to the blade.
+// polygon holding the leaf's outline), scaled to the blade, turned by the leaf's rotation.
 // CPU twin: sylva_core::mesh::mesh_leaves (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> info: MeshInfo;
@@ -9,6 +9,7 @@
 @group(0) @binding(3) var<storage, read> joint: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> acc: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> vertex: array<Vertex>;
+@group(0) @binding(6) var<storage, read> leaf_rotation: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -21,7 +22,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let s = lf.segment;
     let d = acc[s];
     let base = joint[s].xyz + quat_rotate(d, lf.position - segment[s].start);
-    let q = quat_mul(d, lf.orientation);
+    // The leaf's rotation about its attachment (in its segment's rest frame); one past the
+    // array, or the identity, leaves it at rest bit for bit.
+    var lambda = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    if (lf.index < arrayLength(&leaf_rotation)) {
+        lambda = leaf_rotation[lf.index];
+    }
+    var q = quat_mul(d, lf.orientation);
+    if (any(lambda != vec4<f32>(0.0, 0.0, 0.0, 1.0))) {
+        q = quat_mul(d, quat_mul(lambda, lf.orientation));
+    }
     let qx = quat_rotate(q, vec3<f32>(1.0, 0.0, 0.0));
     let qy = quat_rotate(q, vec3<f32>(0.0, 1.0, 0.0));
     let normal = quat_rotate(q, vec3<f32>(0.0, 0.0, 1.0));

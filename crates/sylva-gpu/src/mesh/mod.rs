@@ -31,6 +31,8 @@ pub struct GpuMesh {
     /// Pose buffers used when the pose comes from the CPU.
     joint: wgpu::Buffer,
     acc: wgpu::Buffer,
+    /// Leaf rotations used when the pose comes from the CPU (the identity: leaves at rest).
+    leaf_rotation: wgpu::Buffer,
     /// Bark vertices (storage + vertex buffer).
     pub tube_vertices: wgpu::Buffer,
     /// Bark triangle indices.
@@ -49,6 +51,7 @@ pub struct GpuMesh {
     detail_count: usize,
     leaf_count: usize,
     segment_count: usize,
+    leaf_slots: usize,
 }
 
 pub(crate) fn vertex_buffer(ctx: &GpuContext, label: &'static str, len: usize) -> Result<wgpu::Buffer, GpuError> {
@@ -92,6 +95,11 @@ impl GpuMesh {
             leaves: upload(ctx, "mesh leaves", &layout.leaves)?,
             joint: output::<[f32; 4]>(ctx, "mesh joints", n)?,
             acc: output::<[f32; 4]>(ctx, "mesh rotations", n)?,
+            leaf_rotation: upload(
+                ctx,
+                "mesh leaf rotations",
+                &vec![[0.0f32, 0.0, 0.0, 1.0]; layout.leaf_slots.max(1) as usize],
+            )?,
             tube_vertices: vertex_buffer(ctx, "tube vertices", layout.tube_vertex_count())?,
             tube_indices: index_buffer(ctx, "tube indices", &layout.tube_indices),
             leaf_vertices: vertex_buffer(ctx, "leaf vertices", layout.leaf_vertex_count())?,
@@ -104,17 +112,32 @@ impl GpuMesh {
             detail_count: layout.details.len(),
             leaf_count: layout.leaves.len(),
             segment_count: n,
+            leaf_slots: layout.leaf_slots as usize,
         })
     }
 
     /// Records the vertex kernels reading the pose from `joint` and `acc` (a GPU method's
-    /// [`crate::pose::GpuPose::joints_buffer`] and [`crate::pose::GpuPose::acc_buffer`]).
+    /// [`crate::pose::GpuPose::joints_buffer`] and [`crate::pose::GpuPose::acc_buffer`]),
+    /// leaves at rest on their segments.
     pub fn record(
         &self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         joint: &wgpu::Buffer,
         acc: &wgpu::Buffer,
+    ) {
+        self.record_with_leaves(ctx, encoder, joint, acc, &self.leaf_rotation);
+    }
+
+    /// Records the vertex kernels reading the pose from `joint`, `acc` and the leaves'
+    /// rotations `leaf_rotation` (a GPU method's [`crate::pose::GpuPose::leaf_buffer`]).
+    pub fn record_with_leaves(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        joint: &wgpu::Buffer,
+        acc: &wgpu::Buffer,
+        leaf_rotation: &wgpu::Buffer,
     ) {
         if self.ring_count > 0 {
             self.tubes.record(
@@ -136,7 +159,7 @@ impl GpuMesh {
             self.leaves_kernel.record(
                 ctx,
                 encoder,
-                &[&self.info, &self.leaves, &self.segments, joint, acc, &self.leaf_vertices],
+                &[&self.info, &self.leaves, &self.segments, joint, acc, &self.leaf_vertices, leaf_rotation],
                 self.leaf_count as u32,
             );
         }
@@ -146,9 +169,7 @@ impl GpuMesh {
     pub fn record_pose(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, tree: &Tree, pose: &Pose) {
         let (joint, acc) = pose_buffers(tree, pose);
         debug_assert_eq!(joint.len(), self.segment_count);
-        ctx.queue.write_buffer(&self.joint, 0, bytemuck::cast_slice(&joint));
-        ctx.queue.write_buffer(&self.acc, 0, bytemuck::cast_slice(&acc));
-        self.record(ctx, encoder, &self.joint, &self.acc);
+        self.record_seam(ctx, encoder, &SeamPose { joints: joint, acc, leaf: Vec::new() });
     }
 
     /// Uploads the seam's buffers of a pose made on the CPU (one instance) and records the
@@ -157,6 +178,12 @@ impl GpuMesh {
         debug_assert_eq!(seam.joints.len(), self.segment_count);
         ctx.queue.write_buffer(&self.joint, 0, bytemuck::cast_slice(&seam.joints));
         ctx.queue.write_buffer(&self.acc, 0, bytemuck::cast_slice(&seam.acc));
+        let identity = [0.0f32, 0.0, 0.0, 1.0];
+        let leaves: Vec<[f32; 4]> =
+            (0..self.leaf_slots).map(|l| seam.leaf.get(l).copied().unwrap_or(identity)).collect();
+        if !leaves.is_empty() {
+            ctx.queue.write_buffer(&self.leaf_rotation, 0, bytemuck::cast_slice(&leaves));
+        }
         self.record(ctx, encoder, &self.joint, &self.acc);
     }
 

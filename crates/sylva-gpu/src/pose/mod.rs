@@ -90,6 +90,8 @@ pub struct GpuPose {
     delta: wgpu::Buffer,
     acc: wgpu::Buffer,
     joints: wgpu::Buffer,
+    leaf: wgpu::Buffer,
+    leaves: usize,
     n: usize,
     instances: usize,
     rest_orientation: Vec<Quat>,
@@ -163,10 +165,23 @@ impl GpuPose {
             delta: output::<[f32; 4]>(ctx, "delta", total)?,
             acc: output::<[f32; 4]>(ctx, "acc", total)?,
             joints: output::<[f32; 4]>(ctx, "joints", total)?,
+            leaf: upload(ctx, "leaf rotations", &vec![[0.0f32, 0.0, 0.0, 1.0]; tree.leaves.len().max(1)])?,
+            leaves: tree.leaves.len(),
             n,
             instances,
             rest_orientation: tree.segments.orientation.clone(),
         })
+    }
+
+    /// The first instance's leaf rotations (`λ` of [`sylva_core::pose::SeamPose::leaf`]; the
+    /// identity until a method writes them), one per leaf of the tree.
+    pub fn leaf_buffer(&self) -> &wgpu::Buffer {
+        &self.leaf
+    }
+
+    /// The first instance's leaf rotations read back (waits for the GPU).
+    pub fn read_leaves(&self, ctx: &GpuContext) -> Result<Vec<[f32; 4]>, GpuError> {
+        read_back(ctx, &self.leaf, self.leaves)
     }
 
     /// The buffer a method writes its rotations δ into.

@@ -40,5 +40,5 @@ struct Leaf {
     length: f32,
     segment: u32,
     shape: u32,
-    _pad: u32,
+    index: u32,
 }

@@ -520,6 +520,7 @@ impl WeberPennParams {
             bulge_depth: p.bulge_depth as f32,
         };
         tree.leaf_shape = p.leaf_shape;
+        tree.leaf_motion = p.leaf_motion;
         Ok(tree)
     }
 }

@@ -163,6 +163,9 @@ pub struct WeberPennParams {
     /// Wood properties for mass and stiffness.
     #[serde(default)]
     pub wood: WoodProperties,
+    /// How the leaves move about their petioles.
+    #[serde(default)]
+    pub leaf_motion: crate::leaves::LeafMotion,
 }
 
 fn one() -> f64 {
@@ -295,6 +298,9 @@ impl WeberPennParams {
             if !v.is_finite() || v <= 0.0 {
                 return bad(f(name), format!("{v} must be finite and > 0"));
             }
+        }
+        if let Err((name, v, expected)) = self.leaf_motion.check() {
+            return bad(format!("leaf_motion.{name}"), format!("{v}: expected {expected}"));
         }
         Ok(())
     }

@@ -28,6 +28,7 @@ pub mod raw;
 pub use raw::*;
 
 use super::{Animator, Method, MethodError, MethodOptions, Simulation, check};
+use crate::leaves::LeafFlutter;
 use crate::model::Tree;
 use crate::pose::{Pose, SeamPose};
 use crate::wind::PackedWind;
@@ -136,6 +137,8 @@ pub struct Akagi {
     pub segments: Vec<RawAkagiSegment>,
     /// Segment indices grouped by depth in the hierarchy, deepest first.
     pub buckets: Vec<Vec<u32>>,
+    /// Its leaves' motion ([`crate::leaves`]).
+    pub leaves: LeafFlutter,
     raw: Vec<crate::model::RawSegment>,
     rest: Vec<[f32; 4]>,
 }
@@ -177,7 +180,7 @@ impl Akagi {
         let mut buckets = crate::pose::fk::depth_buckets(&s.parent);
         buckets.reverse();
         let rest = s.start.iter().map(|p| p.extend(0.0).to_array()).collect();
-        Self { params, segments, buckets, raw: tree.raw_segments(), rest }
+        Self { params, segments, buckets, leaves: LeafFlutter::new(tree, tree.seed), raw: tree.raw_segments(), rest }
     }
 
     /// The per-step values the kernels read.
@@ -267,10 +270,11 @@ impl Method for Akagi {
         state.time = time;
     }
 
-    fn seam(&self, _tree: &Tree, _wind: &PackedWind, state: &AkagiState, out: &mut SeamPose) {
+    fn seam(&self, _tree: &Tree, wind: &PackedWind, state: &AkagiState, out: &mut SeamPose) {
         out.joints.clear();
         out.joints.extend(state.pose.start.iter().map(|p| p.extend(0.0).to_array()));
         out.acc.clone_from(&state.acc);
+        self.leaves.seam(wind, self.time(state), out);
     }
 
     fn pose(&self, _tree: &Tree, _wind: &PackedWind, state: &AkagiState) -> Pose {

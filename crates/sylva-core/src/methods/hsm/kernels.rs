@@ -517,6 +517,32 @@ pub fn hsm_pose(segment_cluster: &[u32], state: &[RawHsmClusterState], acc: &mut
     });
 }
 
+/// Leaf rotations from HSM's leaf clusters: `R_s⁻¹ R_leaf`, the identity for a leaf without
+/// a cluster or whose cluster has not turned from its segment. Bindings: 0 leaf segments,
+/// 1 leaf clusters, 2 cluster state, 3 acc, 4 leaf rotations (write).
+pub fn hsm_leaf_pose(
+    leaf_segment: &[u32],
+    leaf_cluster: &[u32],
+    state: &[RawHsmClusterState],
+    acc: &[[f32; 4]],
+    out: &mut [[f32; 4]],
+) {
+    out.par_iter_mut().enumerate().with_min_len(256).for_each(|(l, o)| {
+        let c = leaf_cluster[l];
+        if c == NONE {
+            *o = [0.0, 0.0, 0.0, 1.0];
+            return;
+        }
+        let r = state[c as usize].rotation;
+        let d = acc[leaf_segment[l] as usize];
+        *o = if r == d {
+            [0.0, 0.0, 0.0, 1.0]
+        } else {
+            (glam::Quat::from_array(d).conjugate() * glam::Quat::from_array(r)).to_array()
+        };
+    });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -110,7 +110,7 @@ use crate::pose::{Pose, SeamPose};
 use crate::wind::PackedWind;
 use crate::wind::raw::{RawField, RawWave};
 use glam::Vec3;
-use kernels::{hsm_goals, hsm_integrate, hsm_pose};
+use kernels::{hsm_goals, hsm_integrate, hsm_leaf_pose, hsm_pose};
 use runs::{HsmRuns, avx2_at, hsm_particles_runs};
 use slot_groups::{HsmSlotGroups, hsm_clusters_groups};
 use std::sync::Arc;
@@ -380,6 +380,8 @@ pub struct Hsm {
     /// The layout's slots in groups of eight, for the CPU's stage 1.
     groups: HsmSlotGroups,
     rest_joints: Vec<[f32; 4]>,
+    /// Cluster of each leaf of the tree (`u32::MAX` where a truncated layout has none).
+    pub leaf_cluster: Vec<u32>,
 }
 
 impl Hsm {
@@ -416,7 +418,13 @@ impl Hsm {
         let rest_joints = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
         let runs = HsmRuns::new(&layout);
         let groups = HsmSlotGroups::new(&layout);
-        Self { params, layout, runs, groups, rest_joints }
+        let mut leaf_cluster = vec![NONE; tree.leaves.len()];
+        for (c, info) in layout.info.iter().enumerate() {
+            if info.kind == kind::LEAF && (info.source as usize) < leaf_cluster.len() {
+                leaf_cluster[info.source as usize] = c as u32;
+            }
+        }
+        Self { params, layout, runs, groups, rest_joints, leaf_cluster }
     }
 
     /// The state at rest (without prestress, gravity has yet to sag it: see [`Self::settle`]).
@@ -529,6 +537,14 @@ impl Hsm {
         acc
     }
 
+    /// Each leaf's rotation in its segment's rest frame: its cluster's R turned back by its
+    /// segment's, `R_s⁻¹ R_leaf` (Song §4: a leaf is a cluster of its own). `acc` holds
+    /// the segments' rotations ([`Self::rotations`]).
+    pub fn leaf_rotations(&self, tree: &Tree, state: &HsmState, acc: &[[f32; 4]], out: &mut Vec<[f32; 4]>) {
+        out.resize(self.leaf_cluster.len(), [0.0, 0.0, 0.0, 1.0]);
+        hsm_leaf_pose(&tree.leaves.segment, &self.leaf_cluster, &state.clusters, acc, out);
+    }
+
     /// Where each segment cluster's own transform puts its segment's joint,
     /// `R (x⁰ − c⁰) + c` (a check on the forward-kinematics pose).
     pub fn cluster_joints(&self, tree: &Tree, state: &HsmState) -> Vec<Vec3> {
@@ -596,6 +612,7 @@ impl Method for Hsm {
         out.acc = self.rotations(state);
         out.joints.resize(out.acc.len(), [0.0; 4]);
         crate::pose::fk::positions_forward(&tree.segments.parent, &self.rest_joints, &out.acc, &mut out.joints);
+        self.leaf_rotations(tree, state, &out.acc, &mut out.leaf);
     }
 
     /// Segments turned by their clusters' rotations, joints by forward kinematics.

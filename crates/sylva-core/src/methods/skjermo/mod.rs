@@ -46,6 +46,7 @@ pub use raw::*;
 
 use self::lanes::{LANES, LaneStep, OscLanes, StateLanes, StemLanes};
 use super::{Animator, Method, MethodError, MethodOptions, Simulation, check};
+use crate::leaves::LeafFlutter;
 use crate::model::{NONE, Tree};
 use crate::pose::{Curves, Pose, SeamPose};
 use crate::wind::PackedWind;
@@ -116,6 +117,8 @@ pub struct Skjermo {
     pub segment_param: Vec<[f32; 4]>,
     /// The per-stem constants in groups of sixteen for the fast CPU step.
     pub lanes: Vec<StemLanes>,
+    /// Its leaves' motion ([`crate::leaves`]).
+    pub leaves: LeafFlutter,
     rest_lanes: Vec<StateLanes>,
 }
 
@@ -250,7 +253,16 @@ impl Skjermo {
             })
             .collect::<Vec<_>>();
         let (lanes, rest_lanes) = lanes::build(&stems, &modes, &rest_orient);
-        Self { params, stems, rest_orient, modes, segment_param, lanes, rest_lanes }
+        Self {
+            params,
+            stems,
+            rest_orient,
+            modes,
+            segment_param,
+            lanes,
+            rest_lanes,
+            leaves: LeafFlutter::new(tree, tree.seed),
+        }
     }
 
     /// Rebuilds the fast path's lane groups from `stems` (after editing them).
@@ -419,10 +431,11 @@ impl Method for Skjermo {
         state.time = time;
     }
 
-    fn seam(&self, _tree: &Tree, _wind: &PackedWind, state: &SkjermoState, out: &mut SeamPose) {
+    fn seam(&self, _tree: &Tree, wind: &PackedWind, state: &SkjermoState, out: &mut SeamPose) {
         out.joints.clear();
         out.joints.extend(state.pose.start.iter().map(|p| p.extend(0.0).to_array()));
         out.acc.clone_from(&state.acc);
+        self.leaves.seam(wind, self.time(state), out);
     }
 
     fn pose(&self, _tree: &Tree, _wind: &PackedWind, state: &SkjermoState) -> Pose {

@@ -34,6 +34,7 @@ pub mod trunk;
 pub use raw::*;
 
 use super::{Animator, Method, MethodError, MethodOptions, Simulation, check};
+use crate::leaves::LeafFlutter;
 use crate::model::{NONE, Tree};
 use crate::physics::StemLoad;
 use crate::pose::{Placement, Pose, SeamPose};
@@ -127,6 +128,8 @@ pub struct Zioma {
     pub crown_centre: Vec3,
     /// The trunk's frequency, static bend and damping (the shared physical description).
     pub trunk: TrunkModel,
+    /// Its leaves' motion ([`crate::leaves`]: a closed form in t, as its branches).
+    pub leaves: LeafFlutter,
     tree_seed: u32,
     raw: Vec<crate::model::RawSegment>,
 }
@@ -167,7 +170,15 @@ impl Zioma {
             tree.segments.start.first().map_or(0.0, |p| p.z),
         );
         let trunk = TrunkModel::for_tree(tree, crate::physics::BRANCH_DRAG, crate::physics::LEAF_DRAG);
-        Self { params, stems, crown_centre, trunk, tree_seed: mix64(params.seed) as u32, raw: tree.raw_segments() }
+        Self {
+            params,
+            stems,
+            crown_centre,
+            trunk,
+            leaves: LeafFlutter::new(tree, tree.seed),
+            tree_seed: mix64(params.seed) as u32,
+            raw: tree.raw_segments(),
+        }
     }
 
     /// The ring that keeps the trunk continuous when the wind changes from `old` (ringing by
@@ -345,6 +356,7 @@ impl Method for Zioma {
         let ring = self.current_ring(state, wind);
         *out =
             SeamPose::from_rotations(tree, &self.rotations_ringing(tree, &wind.fields, &wind.waves, state.time, &ring));
+        self.leaves.seam(wind, state.time, out);
     }
 
     fn pose(&self, tree: &Tree, wind: &PackedWind, state: &ZiomaState) -> Pose {

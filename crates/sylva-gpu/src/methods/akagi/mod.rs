@@ -3,6 +3,7 @@
 
 use super::{BuildError, GpuAnimator};
 use crate::kernel::{Kernel, output, upload};
+use crate::leaves::GpuLeafFlutter;
 use crate::pose::{GpuPose, upload_buckets};
 use crate::wind::GpuWind;
 use crate::{GpuContext, GpuError};
@@ -35,6 +36,7 @@ pub struct GpuAkagi {
     sub: wgpu::Buffer,
     theta: wgpu::Buffer,
     omega: wgpu::Buffer,
+    leaves: GpuLeafFlutter,
     /// Simulated time, s.
     pub time: f32,
 }
@@ -65,6 +67,7 @@ impl GpuAkagi {
             sub: output::<[f32; 4]>(ctx, "subtree sums", 3 * n)?,
             theta: output::<[f32; 4]>(ctx, "theta", n)?,
             omega: output::<[f32; 4]>(ctx, "omega", n)?,
+            leaves: GpuLeafFlutter::new(ctx, &method.leaves)?,
             time: 0.0,
             tree,
         };
@@ -101,6 +104,7 @@ impl GpuAkagi {
             n,
         );
         self.pose.record(ctx, &mut e);
+        self.leaves.record_pose(ctx, &mut e, &self.wind, &self.pose, self.time);
         ctx.queue.submit([e.finish()]);
     }
 }

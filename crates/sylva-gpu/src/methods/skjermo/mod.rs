@@ -4,6 +4,7 @@
 
 use super::{BuildError, GpuAnimator, GpuCurves};
 use crate::kernel::{Kernel, output, read_back, upload};
+use crate::leaves::GpuLeafFlutter;
 use crate::pose::GpuPose;
 use crate::wind::GpuWind;
 use crate::{GpuContext, GpuError};
@@ -35,6 +36,7 @@ pub struct GpuSkjermo {
     /// Each stem's rest control points.
     rest_curves: Vec<[Vec3; 4]>,
     method_step: RawSkjermoStep,
+    leaves: GpuLeafFlutter,
     /// Simulated time, s.
     pub time: f32,
 }
@@ -58,6 +60,7 @@ impl GpuSkjermo {
         let rest: Vec<RawSkjermoState> =
             orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect();
         Ok(Self {
+            leaves: GpuLeafFlutter::new(ctx, &method.leaves)?,
             step_kernel: Kernel::get(ctx, "skjermo_step"),
             rotations: Kernel::get(ctx, "skjermo_rotations"),
             pose: GpuPose::new(ctx, &tree)?,
@@ -137,6 +140,7 @@ impl GpuSkjermo {
                 pose.segment_count() as u32,
             );
             pose.record(ctx, &mut e);
+            self.leaves.record_pose(ctx, &mut e, &self.wind, pose, self.time);
         }
         ctx.queue.submit([e.finish()]);
         self.current = 1 - self.current;

@@ -5,6 +5,7 @@ pub mod trunk_noise;
 
 use super::{BuildError, GpuAnimator};
 use crate::kernel::{Kernel, upload};
+use crate::leaves::GpuLeafFlutter;
 use crate::pose::GpuPose;
 use crate::wind::GpuWind;
 use crate::{GpuContext, GpuError};
@@ -26,6 +27,7 @@ pub struct GpuZioma {
     stems: wgpu::Buffer,
     frame: wgpu::Buffer,
     instances: Vec<Placement>,
+    leaves: GpuLeafFlutter,
     /// The trunk's ring-down since the wind last changed (as the CPU's state).
     ring: Ring,
     /// Time of the pose, s.
@@ -60,6 +62,7 @@ impl GpuZioma {
             stems: upload(ctx, "zioma stems", &method.stems)?,
             frame: upload(ctx, "zioma frames", &vec![zeroed; count])?,
             instances: instances.to_vec(),
+            leaves: GpuLeafFlutter::new(ctx, &method.leaves)?,
             tree,
             method,
             time: 0.0,
@@ -91,6 +94,7 @@ impl GpuZioma {
             (self.pose.segment_count() * self.pose.instance_count()) as u32,
         );
         self.pose.record(ctx, &mut encoder);
+        self.leaves.record_pose(ctx, &mut encoder, &self.wind, &self.pose, t);
         ctx.queue.submit([encoder.finish()]);
     }
 

@@ -1,0 +1,90 @@
+// Leaf motion's structs and closed form, shared by leaf_wind and leaf_flutter. Twins:
+// sylva_core::leaves::{RawLeafFrame, RawLeafMotion} and kernels::{leaf_band, leaf_rotation}.
+
+const LEAF_AIR_DENSITY: f32 = 1.225;
+
+struct LeafFrame {
+    time: f32,
+    strength: f32,
+    flutter: f32,
+    zeta: f32,
+    reconfiguration_speed: f32,
+    vogel_exponent: f32,
+    leaves: u32,
+    twigs: u32,
+    flutter_onset: f32,
+    crown_wind: f32,
+    _pad: vec2<u32>,
+}
+
+struct LeafMotion {
+    orientation: vec4<f32>,
+    omega: f32,
+    omega_twist: f32,
+    compliance: f32,
+    flip_pressure: f32,
+    seed: u32,
+    twig: u32,
+    segment: u32,
+    _pad: u32,
+}
+
+fn leaf_smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = clamp((x - e0) / (e1 - e0), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
+// sin of a large argument, reduced by whole turns first (as wind.wgsl's sin_turns).
+fn leaf_sin(x: f32) -> f32 {
+    let turns = round(x * (0.5 / 3.141592653589793));
+    return sin(x - turns * 6.28125 - turns * 0.0019353072);
+}
+
+// Unit-RMS narrow-band flutter: three sines over the half-power band omega (1 ± zeta).
+fn leaf_band(omega: f32, zeta: f32, t: f32, seed: u32) -> f32 {
+    var sum = 0.0;
+    for (var j = 0u; j < 3u; j++) {
+        let w = omega * (1.0 + zeta * (f32(j) - 1.0));
+        let phase = hash_unit(seed + j) * 6.283185307179586;
+        sum += leaf_sin(w * t + phase);
+    }
+    return sum * 0.8164966;
+}
+
+// One leaf's rotation in its segment's rest frame from the wind at its twig (world frame)
+// and its segment's accumulated rotation d.
+fn leaf_rotation(frame: LeafFrame, m: LeafMotion, u_world: vec3<f32>, d: vec4<f32>, t: f32) -> vec4<f32> {
+    let twig = quat_rotate(quat_conj(d), u_world);
+    let u = twig * frame.crown_wind;
+    let speed = length(u);
+    if (frame.strength == 0.0 || speed == 0.0) {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    let q = 0.5 * LEAF_AIR_DENSITY * speed * speed;
+    let q_twig = 0.5 * LEAF_AIR_DENSITY * dot(twig, twig);
+    let r = speed / frame.reconfiguration_speed;
+    let g = pow(1.0 + r * r, 0.5 * frame.vogel_exponent);
+    let k = m.compliance * q * g;
+    let s = k / (1.0 + k);
+    let b = quat_rotate(m.orientation, vec3<f32>(0.0, 1.0, 0.0));
+    let c = cross(b, u);
+    let cl = length(c);
+    let phi = atan2(cl, dot(b, u));
+    var axis = quat_rotate(m.orientation, vec3<f32>(1.0, 0.0, 0.0));
+    if (cl > 1e-6 * speed) {
+        axis = c / cl;
+    }
+    let damped = sqrt(1.0 - frame.zeta * frame.zeta);
+    let omega = m.omega * damped;
+    let omega_twist = m.omega_twist * damped;
+    let onset = frame.flutter_onset * frame.flutter_onset;
+    let amp = frame.flutter * speed * speed / (speed * speed + onset);
+    let pitch = frame.strength * (phi * s + amp * leaf_band(omega, frame.zeta, t, m.seed));
+    let tumble = 0.7853981633974483 * leaf_smoothstep(0.8, 1.25, q_twig / m.flip_pressure);
+    let twist = frame.strength * ((amp + tumble) * leaf_band(omega_twist, frame.zeta, t, m.seed + 3u));
+    let hp = 0.5 * pitch;
+    let ht = 0.5 * twist;
+    let swing = vec4<f32>(axis * sin(hp), cos(hp));
+    let turn = vec4<f32>(b * sin(ht), cos(ht));
+    return quat_mul(swing, turn);
+}

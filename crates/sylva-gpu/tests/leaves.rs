@@ -1,0 +1,195 @@
+//! Leaves that move, GPU against CPU: the leaf kernels (`leaf_wind`, `leaf_flutter`), HSM's
+//! leaf pose (`hsm_leaf_pose`) and the leaf mesher reading leaf rotations, on random trees,
+//! winds, poses and times.
+
+mod common;
+
+use glam::{Quat, Vec3};
+use rand::{Rng, SeedableRng};
+use std::sync::Arc;
+use sylva_core::Tree;
+use sylva_core::leaves::LeafFlutter;
+use sylva_core::mesh::{MeshLayout, MeshParams};
+use sylva_core::pose::SeamPose;
+use sylva_core::species::SpeciesSource;
+use sylva_core::wind::{Constant, WindField, WindScene};
+use sylva_gpu::kernel::{read_back, upload};
+use sylva_gpu::leaves::GpuLeafFlutter;
+use sylva_gpu::mesh::GpuMesh;
+use sylva_gpu::wind::GpuWind;
+
+fn tree(species: &str, seed: u64, leaves: f64) -> Tree {
+    let SpeciesSource::WeberPenn { file, mut params } = SpeciesSource::resolve(species).unwrap() else {
+        unreachable!()
+    };
+    params.scale *= 0.5;
+    params.scale_v *= 0.5;
+    params.leaves *= leaves;
+    SpeciesSource::WeberPenn { file, params }.generate(seed, &Default::default(), None).unwrap()
+}
+
+/// A random pose: every segment turned by up to 0.3 rad about a random axis.
+fn random_seam(tree: &Tree, rng: &mut rand::rngs::StdRng) -> SeamPose {
+    let delta: Vec<[f32; 4]> = (0..tree.segments.len())
+        .map(|_| {
+            let axis = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            Quat::from_axis_angle(axis.normalize_or(Vec3::X), rng.random_range(0.0..0.3)).to_array()
+        })
+        .collect();
+    SeamPose::from_rotations(tree, &delta)
+}
+
+/// A random wind: `gusty` turned and scaled, with a constant of 0–30 m/s on top.
+fn random_wind(rng: &mut rand::rngs::StdRng) -> WindScene {
+    let mut wind = WindScene::resolve("gusty").unwrap();
+    let a: f32 = rng.random_range(0.0..std::f32::consts::TAU);
+    wind.fields
+        .push(WindField::Constant(Constant { direction: [a.cos(), 0.0, a.sin()], speed: rng.random_range(0.0..30.0) }));
+    wind
+}
+
+fn angle_between(a: [f32; 4], b: [f32; 4]) -> f32 {
+    let d = Quat::from_array(a).dot(Quat::from_array(b)).abs().min(1.0);
+    2.0 * d.acos()
+}
+
+/// `leaf_wind` + `leaf_flutter` against their CPU twins on three species, random poses,
+/// winds (to hurricane strength) and times up to 120 s. Tolerance: 5e-3 rad (0.3°) between
+/// the rotations. The leaves' phases `ω t` reach 2·10⁴ rad, where one f32 ulp is 2e-3 rad,
+/// and a GPU may fuse `ω t + φ` where the CPU rounds twice: a phase off by an ulp moves a
+/// flutter of up to 2 rad peak by up to 4e-3 rad. The lean and the wind agree to ~1e-6;
+/// lavapipe measures 1.5e-3 rad.
+#[test]
+fn leaf_kernels_match_the_cpu() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(28);
+    let mut worst = 0.0f32;
+    for (species, seed) in [("quaking_aspen", 1), ("sassafras", 2), ("palm", 3)] {
+        let t = tree(species, seed, 0.2);
+        let flutter = LeafFlutter::new(&t, seed);
+        let gpu = GpuLeafFlutter::new(ctx, &flutter).unwrap();
+        for _ in 0..3 {
+            let wind = random_wind(&mut rng);
+            let gw = GpuWind::from_scene(ctx, &wind).unwrap();
+            let mut seam = random_seam(&t, &mut rng);
+            let time = rng.random_range(0.0..120.0);
+            flutter.seam(&gw.packed, time, &mut seam);
+            let joints = upload(ctx, "joints", &seam.joints).unwrap();
+            let acc = upload(ctx, "acc", &seam.acc).unwrap();
+            let out = upload(ctx, "leaf", &vec![[0.0f32; 4]; t.leaves.len()]).unwrap();
+            let mut e = ctx.device.create_command_encoder(&Default::default());
+            gpu.record(ctx, &mut e, &gw, [&joints, &acc, &out], time);
+            ctx.queue.submit([e.finish()]);
+            let got: Vec<[f32; 4]> = read_back(ctx, &out, t.leaves.len()).unwrap();
+            let moved = seam.leaf.iter().filter(|q| angle_between(**q, [0.0, 0.0, 0.0, 1.0]) > 0.01).count();
+            assert!(2 * moved > t.leaves.len(), "{species}: only {moved} of {} leaves turned", t.leaves.len());
+            for (l, (g, c)) in got.iter().zip(&seam.leaf).enumerate() {
+                let d = angle_between(*g, *c);
+                worst = worst.max(d);
+                assert!(d <= 5e-3, "{species}: leaf {l} at t = {time}: GPU {g:?}, CPU {c:?} ({d} rad apart)");
+            }
+        }
+    }
+    println!("leaf kernels: worst difference {worst:.2e} rad");
+}
+
+/// `hsm_leaf_pose` against its CPU twin on random cluster and segment rotations, with
+/// leaves whose cluster is missing or has not turned (the identity, exactly): within 1e-6.
+#[test]
+fn hsm_leaf_pose_matches_the_cpu() {
+    use sylva_core::methods::hsm::RawHsmClusterState;
+    use sylva_core::methods::hsm::kernels::hsm_leaf_pose;
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+    let (segments, clusters, leaves) = (50usize, 80usize, 500usize);
+    let rot = |rng: &mut rand::rngs::StdRng| {
+        let axis = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        Quat::from_axis_angle(axis.normalize_or(Vec3::Y), rng.random_range(0.0..3.0)).to_array()
+    };
+    let acc: Vec<[f32; 4]> = (0..segments).map(|_| rot(&mut rng)).collect();
+    let mut state = vec![<RawHsmClusterState as bytemuck::Zeroable>::zeroed(); clusters];
+    for s in &mut state {
+        s.rotation = rot(&mut rng);
+    }
+    let leaf_segment: Vec<u32> = (0..leaves).map(|_| rng.random_range(0..segments as u32)).collect();
+    let leaf_cluster: Vec<u32> = (0..leaves)
+        .map(|l| match l % 10 {
+            0 => u32::MAX,
+            1 => {
+                let c = rng.random_range(0..clusters);
+                state[c].rotation = acc[leaf_segment[l] as usize];
+                c as u32
+            }
+            _ => rng.random_range(0..clusters as u32),
+        })
+        .collect();
+    let mut cpu = vec![[0.0f32; 4]; leaves];
+    hsm_leaf_pose(&leaf_segment, &leaf_cluster, &state, &acc, &mut cpu);
+    let buffers = [
+        upload(ctx, "segments", &leaf_segment).unwrap(),
+        upload(ctx, "clusters", &leaf_cluster).unwrap(),
+        upload(ctx, "state", &state).unwrap(),
+        upload(ctx, "acc", &acc).unwrap(),
+        upload(ctx, "out", &vec![[0.0f32; 4]; leaves]).unwrap(),
+    ];
+    let kernel = sylva_gpu::kernel::Kernel::get(ctx, "hsm_leaf_pose");
+    let mut e = ctx.device.create_command_encoder(&Default::default());
+    kernel.record(ctx, &mut e, &buffers.iter().collect::<Vec<_>>(), leaves as u32);
+    ctx.queue.submit([e.finish()]);
+    let gpu: Vec<[f32; 4]> = read_back(ctx, &buffers[4], leaves).unwrap();
+    for l in 0..leaves {
+        if leaf_cluster[l] == u32::MAX || state[leaf_cluster[l] as usize].rotation == acc[leaf_segment[l] as usize] {
+            assert_eq!(gpu[l], [0.0, 0.0, 0.0, 1.0], "leaf {l}");
+            assert_eq!(cpu[l], [0.0, 0.0, 0.0, 1.0], "leaf {l}");
+        }
+        for k in 0..4 {
+            assert!((gpu[l][k] - cpu[l][k]).abs() <= 1e-6, "leaf {l}: GPU {:?}, CPU {:?}", gpu[l], cpu[l]);
+        }
+    }
+}
+
+/// The leaf mesher turning leaves by random rotations, GPU against CPU, within the mesh
+/// parity's bounds (positions 1e-5 × tree height, normals 1e-3); leaves with the identity
+/// mesh exactly as at rest on both.
+#[test]
+fn meshed_leaves_follow_their_rotations_on_both() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(9);
+    let t = Arc::new(tree("quaking_aspen", 4, 0.1));
+    let layout = MeshLayout::new(&t, MeshParams::default()).unwrap();
+    let mesh = GpuMesh::new(ctx, &layout).unwrap();
+    let mut seam = random_seam(&t, &mut rng);
+    let rest = layout.mesh_seam(&seam.joints, &seam.acc, &[]);
+    seam.leaf = (0..t.leaves.len())
+        .map(|l| {
+            if l % 3 == 0 {
+                [0.0, 0.0, 0.0, 1.0]
+            } else {
+                Quat::from_axis_angle(
+                    Vec3::new(rng.random_range(-1.0..1.0), 1.0, 0.3).normalize(),
+                    rng.random_range(0.1..2.0),
+                )
+                .to_array()
+            }
+        })
+        .collect();
+    let cpu = layout.mesh_seam(&seam.joints, &seam.acc, &seam.leaf);
+    let mut e = ctx.device.create_command_encoder(&Default::default());
+    mesh.record_seam(ctx, &mut e, &seam);
+    ctx.queue.submit([e.finish()]);
+    let gpu = mesh.read(ctx).unwrap();
+    let h = t.height();
+    let stride = layout.params.leaf_sides as usize + 1;
+    for (k, (a, b)) in gpu.leaves.iter().zip(&cpu.leaves).enumerate() {
+        let d = (Vec3::from_array(a.position) - Vec3::from_array(b.position)).length();
+        assert!(d <= 1e-5 * h, "leaf vertex {k}: GPU {:?}, CPU {:?}", a.position, b.position);
+        let dn = (Vec3::from_array(a.normal) - Vec3::from_array(b.normal)).length();
+        assert!(dn <= 1e-3, "leaf vertex {k}: normal {:?} vs {:?}", a.normal, b.normal);
+        let l = layout.leaves[k / stride].index as usize;
+        if l % 3 == 0 {
+            assert_eq!(b.position, rest.leaves[k].position, "leaf {l} at rest moved on the CPU");
+        } else if k % stride > 0 {
+            assert_ne!(b.position, rest.leaves[k].position, "leaf {l} did not turn");
+        }
+    }
+}
