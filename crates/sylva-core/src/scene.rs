@@ -245,6 +245,10 @@ pub struct SceneTree {
     /// different groups sway out of step; each costs a simulation and a mesh per frame.
     #[serde(default = "default_phase_groups")]
     pub phase_groups: u32,
+    /// How its leaves move, over the species' ([`crate::leaves::LeafMotion`] fields by name,
+    /// e.g. `leaf_motion = { strength = 0.5 }`; `strength = 0` holds them rigid).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leaf_motion: Option<toml::Table>,
 }
 
 fn default_phase_groups() -> u32 {
@@ -541,6 +545,15 @@ impl Scene {
             }
             if !(1..=MAX_PHASE_GROUPS).contains(&t.phase_groups) {
                 return err(&f("phase_groups"), t.phase_groups.to_string(), "1 to 16 simulations");
+            }
+            if let Some(table) = &t.leaf_motion {
+                if let Err(message) = crate::model::LeafMotion::default().with_table(table) {
+                    return err(
+                        &f("leaf_motion"),
+                        message,
+                        "leaf motion fields in range (see `sylva_core::leaves::LeafMotion`)",
+                    );
+                }
             }
             for (k, c) in t.copies.iter().enumerate() {
                 let f = |key: &str| format!("tree[{i}].copies[{k}].{key}");

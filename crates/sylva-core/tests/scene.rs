@@ -147,3 +147,23 @@ fn a_scene_saved_as_toml_reads_back_equal() {
     let back = Scene::from_toml(&text, &s.file, Path::new(".")).unwrap();
     assert_eq!(back, s, "{text}");
 }
+
+/// A tree's `leaf_motion` sets leaf-motion fields over the species'; an unknown field or a
+/// value out of range names the file, the line and `tree[0].leaf_motion`.
+#[test]
+fn leaf_motion_in_a_scene_is_checked_and_located() {
+    let good =
+        GOOD.replace("method = \"akagi\"", "method = \"akagi\"\nleaf_motion = { strength = 0.5, flutter_deg = 20.0 }");
+    let s = Scene::from_toml(&good, "s.toml", Path::new(".")).unwrap();
+    let table = s.trees[0].leaf_motion.as_ref().unwrap();
+    let m = sylva_core::leaves::LeafMotion::default().with_table(table).unwrap();
+    assert_eq!((m.strength, m.flutter_deg), (0.5, 20.0));
+    assert_eq!(m.petiole_ratio, sylva_core::leaves::LeafMotion::default().petiole_ratio);
+    for (bad, what) in
+        [("strength = -1.0", "strength"), ("wobble = 1.0", "wobble"), ("flip_speed = \"fast\"", "flip_speed")]
+    {
+        let text = GOOD.replace("method = \"akagi\"", &format!("method = \"akagi\"\nleaf_motion = {{ {bad} }}"));
+        let msg = Scene::from_toml(&text, "s.toml", Path::new(".")).unwrap_err().to_string();
+        assert!(msg.contains("s.toml:12") && msg.contains("tree[0].leaf_motion") && msg.contains(what), "{bad}: {msg}");
+    }
+}

@@ -193,3 +193,55 @@ fn meshed_leaves_follow_their_rotations_on_both() {
         }
     }
 }
+
+/// Skinned leaves turned by their rotations: the CPU skin lands every leaf vertex where the
+/// leaf mesher puts it (two independent paths, within 1e-5 × tree height), and the GPU skin
+/// where the CPU skin does, for three instances sharing the leaves' rotations.
+#[test]
+fn skinned_leaves_follow_their_rotations() {
+    use sylva_core::mesh::SkinLayout;
+    use sylva_gpu::mesh::skin::GpuSkin;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(13);
+    let t = tree("quaking_aspen", 6, 0.1);
+    let layout = MeshLayout::new(&t, MeshParams::default()).unwrap();
+    let skin = SkinLayout::new(&layout);
+    let mut seam = random_seam(&t, &mut rng);
+    seam.leaf = (0..t.leaves.len())
+        .map(|_| {
+            Quat::from_axis_angle(
+                Vec3::new(0.3, 1.0, rng.random_range(-1.0..1.0)).normalize(),
+                rng.random_range(0.0..2.5),
+            )
+            .to_array()
+        })
+        .collect();
+    let h = t.height();
+    let meshed = layout.mesh_seam(&seam.joints, &seam.acc, &seam.leaf);
+    let skinned = skin.skin_with_leaves(&seam.joints, &seam.acc, &seam.leaf, 1);
+    let at_rest = skin.skin(&seam.joints, &seam.acc, 1);
+    let mut turned = 0;
+    for (k, (a, b)) in skinned.leaves.iter().zip(&meshed.leaves).enumerate() {
+        let d = (Vec3::from_array(a.position) - Vec3::from_array(b.position)).length();
+        assert!(d <= 1e-5 * h, "leaf vertex {k}: skinned {:?}, meshed {:?}", a.position, b.position);
+        turned += usize::from(a.position != at_rest.leaves[k].position);
+    }
+    assert!(2 * turned > skinned.leaves.len(), "only {turned} skinned leaf vertices turned");
+    let Some(ctx) = common::gpu() else { return };
+    let instances = 3u32;
+    let joint: Vec<[f32; 4]> = seam.joints.iter().cycle().take(seam.joints.len() * 3).copied().collect();
+    let acc: Vec<[f32; 4]> = seam.acc.iter().cycle().take(seam.acc.len() * 3).copied().collect();
+    let cpu = skin.skin_with_leaves(&joint, &acc, &seam.leaf, instances);
+    let g = GpuSkin::new(ctx, &layout, &skin, instances).unwrap();
+    let (jb, ab, lb) =
+        (upload(ctx, "j", &joint).unwrap(), upload(ctx, "a", &acc).unwrap(), upload(ctx, "l", &seam.leaf).unwrap());
+    let mut e = ctx.device.create_command_encoder(&Default::default());
+    g.record_with_leaves(ctx, &mut e, &jb, &ab, &lb);
+    ctx.queue.submit([e.finish()]);
+    let gpu = g.read(ctx).unwrap();
+    for (k, (a, b)) in gpu.leaves.iter().zip(&cpu.leaves).enumerate() {
+        let d = (Vec3::from_array(a.position) - Vec3::from_array(b.position)).length();
+        assert!(d <= 1e-5 * h, "skinned leaf vertex {k}: GPU {:?}, CPU {:?}", a.position, b.position);
+        let dn = (Vec3::from_array(a.normal) - Vec3::from_array(b.normal)).length();
+        assert!(dn <= 1e-3, "skinned leaf vertex {k}: normal {:?} vs {:?}", a.normal, b.normal);
+    }
+}

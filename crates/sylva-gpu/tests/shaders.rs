@@ -520,7 +520,7 @@ fn skin_structs_match_their_wgsl_twins() {
             ("bone0", offset_of!(RawSkin, bone0)),
             ("bone1", offset_of!(RawSkin, bone1)),
             ("weight", offset_of!(RawSkin, weight)),
-            ("_pad", offset_of!(RawSkin, _pad)),
+            ("leaf", offset_of!(RawSkin, leaf)),
         ],
     );
     check_in(

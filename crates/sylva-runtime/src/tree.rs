@@ -155,7 +155,10 @@ struct Forest {
     skin: GpuSkin,
     joint: wgpu::Buffer,
     acc: wgpu::Buffer,
+    /// The first instance's leaf rotations when the pose comes from the CPU (every copy's).
+    leaf: wgpu::Buffer,
     seam: SeamPose,
+    one: SeamPose,
 }
 
 impl Forest {
@@ -163,20 +166,26 @@ impl Forest {
         match &self.sim {
             Simulation::Gpu(g) => {
                 let p = g.pose_buffers();
-                self.skin.record(ctx, encoder, p.joints_buffer(), p.acc_buffer());
+                self.skin.record_with_leaves(ctx, encoder, p.joints_buffer(), p.acc_buffer(), p.leaf_buffer());
             }
             Simulation::Cpu(a) => {
                 if !a.seam_instances(&self.placements, &mut self.seam) {
                     // A method without per-instance poses: every copy takes the one pose.
-                    let mut one = SeamPose::default();
-                    a.seam(&mut one);
+                    a.seam(&mut self.one);
                     let n = self.placements.len();
-                    self.seam.joints = one.joints.iter().cycle().take(n * tree.segments.len()).copied().collect();
-                    self.seam.acc = one.acc.iter().cycle().take(n * tree.segments.len()).copied().collect();
+                    self.seam.joints = self.one.joints.iter().cycle().take(n * tree.segments.len()).copied().collect();
+                    self.seam.acc = self.one.acc.iter().cycle().take(n * tree.segments.len()).copied().collect();
+                    self.seam.leaf.clone_from(&self.one.leaf);
                 }
                 ctx.queue.write_buffer(&self.joint, 0, bytemuck::cast_slice(&self.seam.joints));
                 ctx.queue.write_buffer(&self.acc, 0, bytemuck::cast_slice(&self.seam.acc));
-                self.skin.record(ctx, encoder, &self.joint, &self.acc);
+                let identity = [0.0f32, 0.0, 0.0, 1.0];
+                let leaves: Vec<[f32; 4]> =
+                    (0..tree.leaves.len()).map(|l| self.seam.leaf.get(l).copied().unwrap_or(identity)).collect();
+                if !leaves.is_empty() {
+                    ctx.queue.write_buffer(&self.leaf, 0, bytemuck::cast_slice(&leaves));
+                }
+                self.skin.record_with_leaves(ctx, encoder, &self.joint, &self.acc, &self.leaf);
             }
         }
     }
@@ -248,7 +257,20 @@ impl WorldTree {
         let species_error =
             |source| RuntimeError::Species { file: scene.file.clone(), index: i, source: Box::new(source) };
         let source = SpeciesSource::resolve_with(&species, &scene.limits).map_err(species_error)?;
-        let tree = Arc::new(source.generate(st.seed, &scene.limits, None).map_err(species_error)?);
+        let mut grown = source.generate(st.seed, &scene.limits, None).map_err(species_error)?;
+        if let Some(table) = &st.leaf_motion {
+            grown.leaf_motion = grown.leaf_motion.with_table(table).map_err(|value| {
+                let field = format!("tree[{i}].leaf_motion");
+                RuntimeError::Scene(Box::new(sylva_core::scene::SceneError::Value {
+                    file: scene.file.clone(),
+                    line: scene.line_of(&field),
+                    field,
+                    value,
+                    expected: "leaf motion fields in range (see `sylva_core::leaves::LeafMotion`)".into(),
+                }))
+            })?;
+        }
+        let tree = Arc::new(grown);
         let total = others.saturating_add(Self::elements(&tree, 1 + st.copies.len()));
         if total > scene.limits.max_scene_elements {
             return Err(RuntimeError::Limit(format!(
@@ -394,8 +416,14 @@ impl WorldTree {
                 skin: GpuSkin::new(ctx, &layout, &SkinLayout::new(&layout), placements.len() as u32)?,
                 joint: sylva_gpu::kernel::output::<[f32; 4]>(ctx, "forest joints", n)?,
                 acc: sylva_gpu::kernel::output::<[f32; 4]>(ctx, "forest rotations", n)?,
+                leaf: sylva_gpu::kernel::upload(
+                    ctx,
+                    "forest leaf rotations",
+                    &vec![[0.0f32, 0.0, 0.0, 1.0]; tree.leaves.len().max(1)],
+                )?,
                 placements,
                 seam: SeamPose::default(),
+                one: SeamPose::default(),
             }))
         } else {
             let mut groups = Vec::new();

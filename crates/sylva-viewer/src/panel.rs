@@ -190,6 +190,25 @@ fn tree(ui: &mut egui::Ui, sim: &mut Session, i: usize) {
                 rebuild |= ui.radio_value(&mut st.backend, b, name).changed();
             }
         });
+        // Leaf motion: on or off, and its strength (the scene tree's `leaf_motion.strength`).
+        let strength = st.leaf_motion.as_ref().and_then(|t| t.get("strength")).and_then(|v| v.as_float());
+        let strength = strength.unwrap_or(1.0) as f32;
+        let mut leaves_on = strength > 0.0;
+        // The slider keeps the strength to come back to while leaf motion is off.
+        let mut leaf_strength = if leaves_on { strength } else { 1.0 };
+        ui.horizontal(|ui| {
+            let toggled = ui.checkbox(&mut leaves_on, "leaf motion").changed();
+            let slid = ui
+                .add_enabled(leaves_on, egui::Slider::new(&mut leaf_strength, 0.05..=3.0).text("leaf strength"))
+                .drag_stopped();
+            if toggled || slid {
+                let value = if leaves_on { leaf_strength } else { 0.0 };
+                st.leaf_motion
+                    .get_or_insert_with(Default::default)
+                    .insert("strength".into(), toml::Value::Float(value as f64));
+                rebuild = true;
+            }
+        });
         let mut n = if sim.forest[i] > 0 { sim.forest[i] } else { 1 + st.copies.len() };
         let forest =
             ui.add(egui::Slider::new(&mut n, 1..=MAX_FOREST).logarithmic(true).text("instances")).drag_stopped();

@@ -13,7 +13,8 @@
 //! the branch's origin and by stiffness: `(½ − t) · min(1, 2k / (k + k_parent))`, so a
 //! twig much more flexible than its parent hinges at its base and one as stiff bends with
 //! it. A trunk's base pairs with nothing (the paper's identity). A leaf vertex follows its
-//! segment alone.
+//! segment alone, after its leaf's rotation has turned it about the leaf's attachment
+//! (every instance takes the same leaf rotations: the first instance's).
 //!
 //! The CPU reference `mesh::skin_vertices` is the twin of `skin_vertices.wgsl`; both write
 //! instance-major output (`instance × vertices + vertex`) from instance-major poses.
@@ -32,8 +33,9 @@ pub struct RawSkin {
     pub bone1: u32,
     /// Weight of the second bone, 0…½.
     pub weight: f32,
-    /// Padding.
-    pub _pad: u32,
+    /// 1 + the index of the leaf whose rotation turns this vertex about the leaf's
+    /// attachment before the bones carry it ([`crate::pose::SeamPose::leaf`]); 0 for bark.
+    pub leaf: u32,
 }
 
 /// Sizes for the kernel, 16 bytes. WGSL: `struct SkinInfo`.
@@ -71,6 +73,8 @@ pub struct SkinLayout {
     pub leaf_skin: Vec<RawSkin>,
     /// Rest joint of every segment (w = 0): the bones' rest frames.
     pub rest_joint: Vec<[f32; 4]>,
+    /// Rest attachment of every leaf (w = 0), by leaf index: where its rotation turns it.
+    pub leaf_attach: Vec<[f32; 4]>,
     /// Segments per instance.
     pub segments: u32,
 }
@@ -96,7 +100,7 @@ impl SkinLayout {
             } else {
                 (r.segment, 0.0)
             };
-            RawSkin { bone0: r.segment, bone1, weight, _pad: 0 }
+            RawSkin { bone0: r.segment, bone1, weight, leaf: 0 }
         };
         for r in &layout.rings {
             tube_skin.extend(std::iter::repeat_n(bones(r, r.t), stride));
@@ -108,27 +112,50 @@ impl SkinLayout {
             .leaves
             .iter()
             .flat_map(|l| {
-                std::iter::repeat_n(RawSkin { bone0: l.segment, bone1: l.segment, weight: 0.0, _pad: 0 }, leaf_stride)
+                std::iter::repeat_n(
+                    RawSkin { bone0: l.segment, bone1: l.segment, weight: 0.0, leaf: l.index + 1 },
+                    leaf_stride,
+                )
             })
             .collect();
+        let mut leaf_attach = vec![[0.0f32; 4]; layout.leaf_slots as usize];
+        for l in &layout.leaves {
+            if let Some(a) = leaf_attach.get_mut(l.index as usize) {
+                *a = [l.position[0], l.position[1], l.position[2], 0.0];
+            }
+        }
         Self {
             tube_rest: rest.tubes,
             tube_skin,
             leaf_rest: rest.leaves,
             leaf_skin,
             rest_joint: joint,
+            leaf_attach,
             segments: n as u32,
         }
     }
 
     /// Skins `instances` poses (instance-major joints and rotations) on the CPU: bark and
-    /// leaves, instance-major.
+    /// leaves, instance-major, leaves at rest on their segments.
     pub fn skin(&self, joint: &[[f32; 4]], acc: &[[f32; 4]], instances: u32) -> super::MeshFrame {
+        self.skin_with_leaves(joint, acc, &[], instances)
+    }
+
+    /// As [`Self::skin`], every instance's leaves turned by `leaf_rotation` (one per leaf,
+    /// shared by the instances; empty: at rest).
+    pub fn skin_with_leaves(
+        &self,
+        joint: &[[f32; 4]],
+        acc: &[[f32; 4]],
+        leaf_rotation: &[[f32; 4]],
+        instances: u32,
+    ) -> super::MeshFrame {
         let run = |rest: &[RawVertex], skin: &[RawSkin]| {
             let info =
                 RawSkinInfo { vertices: rest.len() as u32, segments: self.segments, instances, first_instance: 0 };
             let mut out = vec![RawVertex::zeroed(); rest.len() * instances as usize];
-            crate::mesh::skin_vertices(&info, rest, skin, &self.rest_joint, joint, acc, &mut out);
+            let leaves = [&self.leaf_attach[..], leaf_rotation];
+            crate::mesh::skin_vertices(&info, rest, skin, &self.rest_joint, joint, acc, &mut out, leaves);
             out
         };
         super::MeshFrame { tubes: run(&self.tube_rest, &self.tube_skin), leaves: run(&self.leaf_rest, &self.leaf_skin) }

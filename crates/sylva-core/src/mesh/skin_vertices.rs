@@ -14,8 +14,12 @@ fn bone(rest_joint: &[[f32; 4]], joint: &[[f32; 4]], acc: &[[f32; 4]], base: usi
 }
 
 /// Writes `out[instance × vertices + v]` for the dispatch's instances, reading pose
-/// `first_instance + instance`. Bindings as in the kernel: 0 info, 1 rest, 2 skin,
-/// 3 rest joints (one instance), 4 joints, 5 rotations (instance-major), 6 out (write).
+/// `first_instance + instance`. A leaf vertex (`RawSkin::leaf` > 0) is first turned about
+/// its leaf's attachment by the leaf's rotation (one past the array, or the identity, leaves
+/// it as it is). Bindings as in the kernel: 0 info, 1 rest, 2 skin, 3 rest joints (one
+/// instance), 4 joints, 5 rotations (instance-major), 6 out (write), 7 leaf attachments,
+/// 8 leaf rotations.
+#[allow(clippy::too_many_arguments)]
 pub fn skin_vertices(
     info: &RawSkinInfo,
     rest: &[RawVertex],
@@ -24,13 +28,24 @@ pub fn skin_vertices(
     joint: &[[f32; 4]],
     acc: &[[f32; 4]],
     out: &mut [RawVertex],
+    [leaf_attach, leaf_rotation]: [&[[f32; 4]]; 2],
 ) {
     let n = info.vertices as usize;
     out.par_iter_mut().enumerate().for_each(|(id, o)| {
         let (inst, v) = (id / n, id % n);
         let base = (info.first_instance as usize + inst) * info.segments as usize;
-        let (x, nrm) = (Vec3::from_array(rest[v].position), Vec3::from_array(rest[v].normal));
+        let (mut x, mut nrm) = (Vec3::from_array(rest[v].position), Vec3::from_array(rest[v].normal));
         let s = skin[v];
+        if s.leaf > 0 {
+            let l = (s.leaf - 1) as usize;
+            if let (Some(&q), Some(&a)) = (leaf_rotation.get(l), leaf_attach.get(l)) {
+                if q != [0.0, 0.0, 0.0, 1.0] {
+                    let (q, a) = (Quat::from_array(q), Vec3::new(a[0], a[1], a[2]));
+                    x = a + q * (x - a);
+                    nrm = q * nrm;
+                }
+            }
+        }
         let (j0, d0, r0) = bone(rest_joint, joint, acc, base, s.bone0 as usize);
         let (j1, d1, r1) = bone(rest_joint, joint, acc, base, s.bone1 as usize);
         let w = s.weight;

@@ -17,7 +17,7 @@
 //!
 //! One folder per method holds its parameters, its GPU-layout types (`raw.rs`), the CPU
 //! twins of its kernels and its fast CPU forms, and a `animator` constructor for the
-//! registry. A method uses the shared modules (`model`, `wind`, `physics`, `pose`), never
+//! registry. A method uses the shared modules (`model`, `wind`, `physics`, `pose`, `leaves`), never
 //! another method.
 
 pub mod akagi;
@@ -120,7 +120,8 @@ pub trait Method: Debug + Send + Sync + 'static {
     }
 
     /// Poses every placed instance on its own (wind sampled at the instance, its own phase)
-    /// into `out`, instance-major; false for methods whose copies share a simulation.
+    /// into `out`, instance-major, with the first instance's leaf rotations (which every
+    /// copy takes); false for methods whose copies share a simulation.
     fn seam_instances(
         &self,
         _tree: &Tree,

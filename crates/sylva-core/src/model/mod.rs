@@ -15,12 +15,14 @@
 mod bezier;
 mod builder;
 mod digest;
+pub mod leaf_motion;
 pub mod leaf_shape;
 mod raw;
 mod validate;
 
 pub use bezier::{CubicBezier, fit_cubic_bezier};
 pub use builder::{LeafDraft, SegmentDraft, StemDraft, TreeBuilder};
+pub use leaf_motion::LeafMotion;
 pub use leaf_shape::LeafShape;
 pub use raw::{RawLeaf, RawSegment, RawStem};
 pub use validate::ModelError;
@@ -229,7 +231,7 @@ pub struct Tree {
     /// The outline of every leaf (Weber–Penn `LeafShape`).
     pub leaf_shape: LeafShape,
     /// How its leaves move about their petioles.
-    pub leaf_motion: crate::leaves::LeafMotion,
+    pub leaf_motion: LeafMotion,
 }
 
 /// The trunk's shape beyond its segments' radii (Weber–Penn `Flare`, `Lobes`, `LobeDepth`;

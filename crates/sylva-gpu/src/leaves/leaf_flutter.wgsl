@@ -14,5 +14,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         return;
     }
     let m = motion[l];
-    leaf_rotation_out[l] = leaf_rotation(frame, m, twig_wind[m.twig].xyz, acc[m.segment], frame.time);
+    leaf_rotation_out[l] = leaf_rotation(frame, m, twig_wind[2u * m.twig], twig_wind[2u * m.twig + 1u], acc[m.segment], frame.time);
 }

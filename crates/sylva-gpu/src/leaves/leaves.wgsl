@@ -51,20 +51,18 @@ fn leaf_band(omega: f32, zeta: f32, t: f32, seed: u32) -> f32 {
     return sum * 0.8164966;
 }
 
-// One leaf's rotation in its segment's rest frame from the wind at its twig (world frame)
-// and its segment's accumulated rotation d.
-fn leaf_rotation(frame: LeafFrame, m: LeafMotion, u_world: vec3<f32>, d: vec4<f32>, t: f32) -> vec4<f32> {
-    let twig = quat_rotate(quat_conj(d), u_world);
-    let u = twig * frame.crown_wind;
+// One leaf's rotation in its segment's rest frame from its twig's two entries of leaf_wind
+// (wind xyz, q g; flutter amplitude, dynamic pressure at the twig) and its segment's
+// accumulated rotation d.
+fn leaf_rotation(frame: LeafFrame, m: LeafMotion, w: vec4<f32>, s2: vec4<f32>, d: vec4<f32>, t: f32) -> vec4<f32> {
+    let u = quat_rotate(quat_conj(d), w.xyz);
     let speed = length(u);
-    if (frame.strength == 0.0 || speed == 0.0) {
+    if (frame.strength == 0.0 || speed == 0.0 || frame.crown_wind == 0.0) {
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
-    let q = 0.5 * LEAF_AIR_DENSITY * speed * speed;
-    let q_twig = 0.5 * LEAF_AIR_DENSITY * dot(twig, twig);
-    let r = speed / frame.reconfiguration_speed;
-    let g = pow(1.0 + r * r, 0.5 * frame.vogel_exponent);
-    let k = m.compliance * q * g;
+    let amp = s2.x;
+    let q_twig = s2.y;
+    let k = m.compliance * w.w;
     let s = k / (1.0 + k);
     let b = quat_rotate(m.orientation, vec3<f32>(0.0, 1.0, 0.0));
     let c = cross(b, u);
@@ -77,8 +75,6 @@ fn leaf_rotation(frame: LeafFrame, m: LeafMotion, u_world: vec3<f32>, d: vec4<f3
     let damped = sqrt(1.0 - frame.zeta * frame.zeta);
     let omega = m.omega * damped;
     let omega_twist = m.omega_twist * damped;
-    let onset = frame.flutter_onset * frame.flutter_onset;
-    let amp = frame.flutter * speed * speed / (speed * speed + onset);
     let pitch = frame.strength * (phi * s + amp * leaf_band(omega, frame.zeta, t, m.seed));
     let tumble = 0.7853981633974483 * leaf_smoothstep(0.8, 1.25, q_twig / m.flip_pressure);
     let twist = frame.strength * ((amp + tumble) * leaf_band(omega_twist, frame.zeta, t, m.seed + 3u));

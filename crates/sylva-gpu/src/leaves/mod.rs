@@ -30,7 +30,7 @@ impl GpuLeafFlutter {
             frame: upload(ctx, "leaf frame", &[leaves.frame(0.0)])?,
             motion: upload(ctx, "leaf motion", &leaves.leaves)?,
             twigs: upload(ctx, "leaf twigs", &leaves.twigs)?,
-            twig_wind: output::<[f32; 4]>(ctx, "twig wind", leaves.twigs.len())?,
+            twig_wind: output::<[f32; 4]>(ctx, "twig wind", 2 * leaves.twigs.len())?,
             leaves: leaves.clone(),
         })
     }
@@ -58,7 +58,7 @@ impl GpuLeafFlutter {
         [joints, acc, out]: [&wgpu::Buffer; 3],
         t: f32,
     ) {
-        if self.leaves.leaves.is_empty() {
+        if self.leaves.leaves.is_empty() || self.leaves.params.strength == 0.0 {
             return;
         }
         let frame: RawLeafFrame = self.leaves.frame(t);

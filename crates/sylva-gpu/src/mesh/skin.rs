@@ -44,6 +44,9 @@ impl std::fmt::Debug for Batch {
 pub struct GpuSkin {
     kernel: Arc<Kernel>,
     rest_joint: wgpu::Buffer,
+    leaf_attach: wgpu::Buffer,
+    /// The identity for every leaf: leaves at rest.
+    leaf_rest: wgpu::Buffer,
     tubes: Part,
     leaves: Part,
     batches: Vec<Batch>,
@@ -103,6 +106,12 @@ impl GpuSkin {
         Ok(Self {
             kernel: Kernel::get(ctx, "skin_vertices"),
             rest_joint: upload(ctx, "skin rest joints", &skin.rest_joint)?,
+            leaf_attach: upload(ctx, "skin leaf attachments", &skin.leaf_attach)?,
+            leaf_rest: upload(
+                ctx,
+                "skin leaf rotations",
+                &vec![[0.0f32, 0.0, 0.0, 1.0]; skin.leaf_attach.len().max(1)],
+            )?,
             tubes,
             leaves,
             batches,
@@ -115,7 +124,7 @@ impl GpuSkin {
         self.batches.len()
     }
 
-    /// Records skinning of every instance from instance-major pose buffers.
+    /// Records skinning of every instance from instance-major pose buffers, leaves at rest.
     pub fn record(
         &self,
         ctx: &GpuContext,
@@ -123,13 +132,27 @@ impl GpuSkin {
         joint: &wgpu::Buffer,
         acc: &wgpu::Buffer,
     ) {
+        self.record_with_leaves(ctx, encoder, joint, acc, &self.leaf_rest);
+    }
+
+    /// Records skinning of every instance, every instance's leaves turned by
+    /// `leaf_rotation` (one per leaf, shared: a GPU method's
+    /// [`crate::pose::GpuPose::leaf_buffer`]).
+    pub fn record_with_leaves(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        joint: &wgpu::Buffer,
+        acc: &wgpu::Buffer,
+        leaf_rotation: &wgpu::Buffer,
+    ) {
         for b in &self.batches {
             for (p, (info, out)) in [&self.tubes, &self.leaves].into_iter().zip(&b.out) {
                 if p.vertices > 0 {
                     self.kernel.record(
                         ctx,
                         encoder,
-                        &[info, &p.rest, &p.skin, &self.rest_joint, joint, acc, out],
+                        &[info, &p.rest, &p.skin, &self.rest_joint, joint, acc, out, &self.leaf_attach, leaf_rotation],
                         (p.vertices * b.count as usize) as u32,
                     );
                 }

@@ -165,7 +165,7 @@ pub struct WeberPennParams {
     pub wood: WoodProperties,
     /// How the leaves move about their petioles.
     #[serde(default)]
-    pub leaf_motion: crate::leaves::LeafMotion,
+    pub leaf_motion: crate::model::LeafMotion,
 }
 
 fn one() -> f64 {

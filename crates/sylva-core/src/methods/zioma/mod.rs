@@ -375,6 +375,11 @@ impl Method for Zioma {
         let ring = self.current_ring(state, wind);
         let delta = self.rotations_instances_ringing(tree, &wind.fields, &wind.waves, state.time, instances, &ring);
         *out = SeamPose::from_rotations(tree, &delta);
+        // The first instance's leaves (every copy's, as skinning shares them).
+        let n = tree.segments.len().min(out.joints.len());
+        let mut leaf = std::mem::take(&mut out.leaf);
+        self.leaves.write(wind, state.time, &out.joints[..n], &out.acc[..n], &mut leaf);
+        out.leaf = leaf;
         true
     }
 }
