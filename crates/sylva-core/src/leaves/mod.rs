@@ -17,8 +17,8 @@
 //!   midrib, `k_t = (GJ/EI) k` against `m w² / 12`. A leaf rings at least [`ABOVE_TWIG`]
 //!   times its twig's first mode ([`crate::physics::stem_frequencies`]): a blade whose
 //!   petiole alone would ring slower (a long blade or frond on a stiff short twig) would move
-//!   with its twig rather than about it, and its stiffness is raised to match. Swing stays
-//!   under [`MAX_LEAF_HZ`] and twist under twice that, so a 60 Hz step resolves both.
+//!   with its twig rather than about it, and its stiffness is raised to match. Swing and
+//!   twist stay under [`MAX_LEAF_HZ`], so a 60 Hz step (and a 30 fps render) resolves both.
 //! * **Lean (lift and drag).** The normal force `C_N A q g(u)` (dynamic pressure q of the
 //!   wind inside the crown, `crown_wind` of the wind at the twig; reconfiguration g of
 //!   [`crate::physics::drag`]) at the blade's centre against `k`: the
@@ -205,8 +205,8 @@ pub struct LeafConstants {
     pub compliance: f32,
 }
 
-/// Highest swing frequency a leaf is given, Hz: a 60 Hz step resolves it (12 steps a cycle
-/// at most 5, three samples a cycle at the band's top).
+/// Highest swing or twist frequency a leaf is given, Hz: a 60 Hz step samples the band's top
+/// (12 Hz × 1.15) four times a cycle.
 pub const MAX_LEAF_HZ: f32 = 12.0;
 
 /// How far above its twig's first mode a leaf rings at least.
@@ -230,7 +230,7 @@ pub fn leaf_constants(p: &LeafMotion, width: f32, length: f32, rho_a: f32, twig_
     let k = j * omega * omega;
     LeafConstants {
         omega,
-        omega_twist: (p.petiole_torsion * k / j_twist).sqrt().min(2.0 * omega_max),
+        omega_twist: (p.petiole_torsion * k / j_twist).sqrt().min(omega_max),
         compliance: p.normal_force * area * r / k,
     }
 }
