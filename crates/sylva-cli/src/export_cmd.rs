@@ -51,9 +51,14 @@ pub struct ExportArgs {
     /// Joints of the skin.
     #[arg(long, value_enum, default_value = "segment")]
     pub joints: Joints,
-    /// Refuse to write a skin with more joints than this (your engine's bone limit).
+    /// Refuse to write a skin with more joints than this (your engine's bone limit), leaf
+    /// joints included.
     #[arg(long)]
     pub max_joints: Option<usize>,
+    /// No leaf joints: leaves stay rigid with their branch in the clip (their flutter is
+    /// still in the `_LEAF_FLUTTER` attribute, for an engine shader).
+    #[arg(long, conflicts_with = "static_only")]
+    pub no_leaf_joints: bool,
     /// A level of detail as `sides,samples,leaf_sides,leaf_keep` (repeat for several,
     /// finest first). Default: 8,3,8,1 6,2,6,0.5 4,1,4,0.25.
     #[arg(long = "lod", value_parser = parse_lod)]
@@ -103,6 +108,7 @@ pub fn run(a: &ExportArgs) -> Result<PathBuf> {
         },
         max_joints: a.max_joints,
         lods: if a.lods.is_empty() { DEFAULT_LODS.to_vec() } else { a.lods.clone() },
+        leaf_joints: !a.no_leaf_joints,
     };
     let (tree, wind) = a.tree.resolve()?;
     let tree = std::sync::Arc::new(tree);
@@ -175,8 +181,9 @@ pub fn export(
     }
     if let Some(c) = &clip {
         println!(
-            "  skin: {} joints; animation `wind`: {} keys ({:.2} s at {} fps{}), {} channels, {:.2} MiB",
+            "  skin: {} joints ({} of them leaf joints); animation `wind`: {} keys ({:.2} s at {} fps{}), {} channels, {:.2} MiB",
             report.joints,
+            report.leaf_joints,
             report.frames,
             c.duration(),
             c.fps,

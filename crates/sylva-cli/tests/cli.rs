@@ -739,7 +739,23 @@ fn export_writes_a_looping_glb_and_reports_every_lod() {
     for lod in ["  0 ", "  1 ", "  2 "] {
         assert!(out.lines().any(|l| l.starts_with(lod)), "LOD row `{lod}` missing:\n{out}");
     }
-    assert!(out.contains("21 keys") && out.contains("looping") && out.contains("309 joints"), "{out}");
+    assert!(out.contains("21 keys") && out.contains("looping"), "{out}");
+    // Joints: one per segment and a leaf joint per leaf-bearing segment.
+    let joints = |out: &str| -> (usize, usize) {
+        let line = out.lines().find(|l| l.contains("skin:")).unwrap_or_else(|| panic!("no skin line:\n{out}"));
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let n =
+            |w: &str| words[words.iter().position(|x| *x == w).unwrap() - 1].trim_start_matches('(').parse().unwrap();
+        (n("joints"), n("of"))
+    };
+    let (all, leaf) = joints(&out);
+    assert!(leaf > 0 && all == 309 + leaf, "{out}");
+    let (ok, out, err) = sylva(
+        dir.path(),
+        &["export", "--species", "palm", "--seconds", "0.5", "--no-leaf-joints", "--out", "rigid.glb"],
+    );
+    assert!(ok, "{out}\n{err}");
+    assert_eq!(joints(&out), (309, 0), "{out}");
     // Static .gltf: one JSON file, no skin.
     let (ok, out, err) = sylva(dir.path(), &["export", "--species", "palm", "--static", "--out", "palm.gltf"]);
     assert!(ok, "{out}\n{err}");
@@ -762,6 +778,7 @@ fn export_rejects_bad_input_and_leaves_no_file() {
         (&["--out", "tree.fbx"], ".glb or .gltf"),
         (&["--out", "/proc/sylva/tree.glb"], "/proc/sylva"),
         (&["--loop", "--seconds", "1", "--blend", "0.9"], "`blend` = 0.9"),
+        (&["--static", "--no-leaf-joints"], "cannot be used with"),
     ];
     for (args, expect) in cases {
         let mut all = vec!["export", "--species", "palm"];

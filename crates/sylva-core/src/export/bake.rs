@@ -1,6 +1,7 @@
 //! Baking: any animation method run on the CPU and sampled at a fixed frame rate into a
 //! [`Clip`] — per frame the pose seam's buffers (joint positions and accumulated
-//! rotations `D` per segment), which skinning and the glTF exporter consume.
+//! rotations `D` per segment, a rotation per leaf), which skinning and the glTF exporter
+//! consume.
 //!
 //! # Looping clips
 //!
@@ -15,7 +16,8 @@
 //! at the start is `p′(T)`, the velocity at its end: no jump in pose or speed across the
 //! seam. Blending is done on each segment's *local* transform (rotation and offset relative
 //! to its parent: slerp and lerp), and the pose is rebuilt root to tip, so the skeleton
-//! stays connected while blending. The last frame is a copy of the first (glTF clips play
+//! stays connected while blending; a leaf's rotation, already relative to its segment, is
+//! slerped. The last frame is a copy of the first (glTF clips play
 //! from the first key to the last).
 
 use crate::mesh::quat_slerp;
@@ -25,7 +27,7 @@ use crate::pose::SeamPose;
 use crate::wind::WindScene;
 use glam::{Quat, Vec3};
 
-/// Largest `frames × segments` a clip may hold (32 bytes each: 512 MiB).
+/// Largest `frames × (segments + leaves)` a clip may hold (at most 32 bytes each: 512 MiB).
 pub const MAX_CLIP_VALUES: u64 = 16 << 20;
 
 /// How to bake (the method is the caller's: any [`Animator`]).
@@ -62,7 +64,7 @@ pub enum BakeError {
     Param { field: &'static str, value: String, expected: String },
     /// The clip would be too large.
     #[error(
-        "the clip would hold {frames} frames × {segments} segments; the limit is {limit} (shorten it, lower the fps or use a smaller tree)"
+        "the clip would hold {frames} frames × {segments} segments and leaves; the limit is {limit} (shorten it, lower the fps or use a smaller tree)"
     )]
     TooLarge { frames: u64, segments: u64, limit: u64 },
     /// The method could not be built.
@@ -81,6 +83,9 @@ pub struct Clip {
     pub joints: Vec<Vec<[f32; 4]>>,
     /// Accumulated rotation `D` of every segment, per frame.
     pub acc: Vec<Vec<[f32; 4]>>,
+    /// Rotation of every leaf relative to its segment ([`SeamPose::leaf`]), per frame; an
+    /// empty frame has every leaf at rest.
+    pub leaves: Vec<Vec<[f32; 4]>>,
 }
 
 impl Clip {
@@ -158,7 +163,7 @@ pub fn bake(
 ) -> Result<Clip, BakeError> {
     let tree = anim.tree().clone();
     let tree = &*tree;
-    let (n, blend, steps) = params.check(tree.segments.len())?;
+    let (n, blend, steps) = params.check(tree.segments.len() + tree.leaves.len())?;
     anim.set_wind(std::sync::Arc::new(wind.packed()));
     let dt = 1.0 / (params.fps * steps as f32);
     // Preroll: whole frames of simulated time before frame 0.
@@ -167,17 +172,20 @@ pub fn bake(
     let total = n + 1 + blend;
     let mut joints = Vec::with_capacity(total);
     let mut acc = Vec::with_capacity(total);
+    let mut leaves = Vec::with_capacity(total);
     let mut seam = SeamPose::default();
     for k in 0..total {
         anim.advance(dt, if k == 0 { 0 } else { steps });
         anim.seam(&mut seam);
         joints.push(seam.joints.clone());
         acc.push(seam.acc.clone());
+        leaves.push(seam.leaf.clone());
         progress(k + 1, total);
     }
     if params.looped {
         let mut out_j = Vec::with_capacity(n + 1);
         let mut out_a = Vec::with_capacity(n + 1);
+        let mut out_l = Vec::with_capacity(n + 1);
         for k in 0..n {
             if k < blend {
                 let x = k as f32 / blend as f32;
@@ -185,17 +193,21 @@ pub fn bake(
                 let (j, a) = blend_poses(tree, (&joints[k + n], &acc[k + n]), (&joints[k], &acc[k]), w);
                 out_j.push(j);
                 out_a.push(a);
+                out_l.push(blend_leaves(&leaves[k + n], &leaves[k], w));
             } else {
                 out_j.push(std::mem::take(&mut joints[k]));
                 out_a.push(std::mem::take(&mut acc[k]));
+                out_l.push(std::mem::take(&mut leaves[k]));
             }
         }
         out_j.push(out_j[0].clone());
         out_a.push(out_a[0].clone());
+        out_l.push(out_l[0].clone());
         joints = out_j;
         acc = out_a;
+        leaves = out_l;
     }
-    Ok(Clip { fps: params.fps, looped: params.looped, joints, acc })
+    Ok(Clip { fps: params.fps, looped: params.looped, joints, acc, leaves })
 }
 
 /// Each segment's transform relative to its parent's: rotation `D_p⁻¹ D` and offset
@@ -237,6 +249,12 @@ pub fn from_local_transforms(tree: &Tree, rot: &[Quat], offset: &[Vec3]) -> (Vec
         }
     }
     (j.iter().map(|p| p.extend(0.0).to_array()).collect(), d.iter().map(|q| q.to_array()).collect())
+}
+
+/// Leaf rotations `a` blended toward `b` by `w` (0 = a, 1 = b); an empty side is at rest.
+fn blend_leaves(a: &[[f32; 4]], b: &[[f32; 4]], w: f32) -> Vec<[f32; 4]> {
+    let at = |x: &[[f32; 4]], i: usize| x.get(i).map_or(Quat::IDENTITY, |q| Quat::from_array(*q));
+    (0..a.len().max(b.len())).map(|i| quat_slerp(at(a, i), at(b, i), w).to_array()).collect()
 }
 
 /// `a` blended toward `b` by `w` (0 = a, 1 = b), per segment in local terms.

@@ -131,7 +131,8 @@ impl Builder {
         let uv: Vec<f32> = v.iter().flat_map(|x| [x.u, x.v]).collect();
         attributes.insert(Valid(Semantic::TexCoords(0)), self.floats(&uv, Vec2, true));
         if skinned {
-            let (joints, weights): (Vec<[u16; 4]>, Vec<[f32; 4]>) = g.skin.iter().map(|s| rig.bind(s)).unzip();
+            let (joints, weights): (Vec<[u16; 4]>, Vec<[f32; 4]>) =
+                g.skin.iter().zip(v).map(|(s, x)| rig.bind(s, x.v)).unzip();
             let j = self.accessor(
                 bytemuck::cast_slice(&joints),
                 joints.len(),
@@ -155,6 +156,10 @@ impl Builder {
         attributes.insert(Valid(Semantic::Extras("PARENT_PIVOT".into())), self.floats(&parent, V3, true));
         let phase: Vec<f32> = e.iter().map(|x| x.phase).collect();
         attributes.insert(Valid(Semantic::Extras("PHASE".into())), self.floats(&phase, Scalar, true));
+        if !g.flutter.is_empty() {
+            let flutter: Vec<f32> = g.flutter.iter().flatten().copied().collect();
+            attributes.insert(Valid(Semantic::Extras("LEAF_FLUTTER".into())), self.floats(&flutter, V3, true));
+        }
         let indices = self.accessor(
             bytemuck::cast_slice(g.indices),
             g.indices.len(),
@@ -175,7 +180,8 @@ impl Builder {
     }
 
     /// Samplers and channels of the clip: local rotation (and, where it changes,
-    /// translation) of every joint that moves.
+    /// translation) of every skeleton joint that moves, and the rotation of every leaf joint
+    /// that turns.
     pub(super) fn animation(
         &mut self,
         tree: &Tree,
@@ -186,10 +192,11 @@ impl Builder {
     ) -> Result<(Vec<json::animation::Sampler>, Vec<json::animation::Channel>), GltfError> {
         let frames = clip.frames();
         let joints = rig.driver.len();
-        let bytes = frames as u64 * joints as u64 * 28;
+        let bytes = frames as u64 * rig.joints() as u64 * 28;
         if self.bin.len() as u64 + bytes > MAX_BIN_BYTES {
             return Err(GltfError::TooLarge { bytes: self.bin.len() as u64 + bytes, limit: MAX_BIN_BYTES });
         }
+        let s = &tree.segments;
         let times: Vec<f32> = (0..frames).map(|k| k as f32 / clip.fps).collect();
         let input = self.accessor(
             bytemuck::cast_slice(&times),
@@ -199,9 +206,11 @@ impl Builder {
             None,
             Some((vec![0.0], vec![times[frames - 1]])),
         );
-        // Local transforms per frame, joint-major.
-        let mut rot = vec![Quat::IDENTITY; frames * joints];
-        let mut off = vec![Vec3::ZERO; frames * joints];
+        // Local transforms per frame, joint-major; leaf joints after the skeleton's, their
+        // offsets from their parents constant.
+        let all = rig.joints();
+        let mut rot = vec![Quat::IDENTITY; frames * all];
+        let mut off = vec![Vec3::ZERO; frames * all];
         for f in 0..frames {
             let (j, d) = (&clip.joints[f], &clip.acc[f]);
             for (k, &s) in rig.driver.iter().enumerate() {
@@ -217,14 +226,21 @@ impl Builder {
                 rot[k * frames + f] = r.normalize();
                 off[k * frames + f] = o;
             }
+            for (g, group) in rig.leaf_groups.iter().enumerate() {
+                let k = joints + g;
+                rot[k * frames + f] = rig::group_rotation(group, clip.leaves.get(f).map_or(&[], Vec::as_slice));
+                off[k * frames + f] = group.pivot - s.start[rig.driver[group.parent as usize]];
+            }
         }
         let mut samplers = Vec::new();
         let mut channels = Vec::new();
-        let s = &tree.segments;
-        for k in 0..joints {
-            let rest = match rig.parent[k] {
-                NONE => s.start[rig.driver[k]],
-                p => s.start[rig.driver[k]] - s.start[rig.driver[p as usize]],
+        for k in 0..all {
+            let rest = match k.checked_sub(joints) {
+                Some(_) => off[k * frames],
+                None => match rig.parent[k] {
+                    NONE => s.start[rig.driver[k]],
+                    p => s.start[rig.driver[k]] - s.start[rig.driver[p as usize]],
+                },
             };
             let r = &mut rot[k * frames..(k + 1) * frames];
             for f in 1..frames {

@@ -11,7 +11,15 @@
 //! a pure translation), so a joint's world transform at a frame is exactly Sylva's bone
 //! transform `x ↦ j + D (x − j_rest)` ([`crate::mesh::skin`]). Vertices carry at most two
 //! joints (`JOINTS_0` u16, `WEIGHTS_0` float, summing to 1): a bark vertex blends its
-//! segment with the neighbour toward the nearer joint, a leaf follows its segment.
+//! segment with the neighbour toward the nearer joint; a leaf vertex blends its segment's
+//! joint into its leaf joint by its blade coordinate `v` (below).
+//!
+//! **Leaf joints** ([`GltfOptions::leaf_joints`]): every joint carrying leaves gets a child
+//! joint pivoting at the mean of its leaves' attachments, keyed with the normalised sum of
+//! their rotations relative to their segment (the least-squares single turn of the group).
+//! Weighting a leaf vertex `v` (0 at the attachment, 1 at the tip) on the leaf joint keeps
+//! the attachment exactly on the twig while the blade turns. What differs from leaf to leaf
+//! (each leaf's flutter phase) is left to an engine shader through `_LEAF_FLUTTER`.
 //!
 //! **Merging per stem**: stem `k`'s joint is driven by the stem's first segment (its base),
 //! and every vertex of the stem is bound to it, so a stem moves as a rigid body about its
@@ -22,7 +30,7 @@
 //! # Animation
 //!
 //! One clip, `wind`, with a key per frame of the [`Clip`] (linear interpolation): a
-//! rotation channel per joint that moves, and a translation channel for a joint whose
+//! rotation channel per joint that moves (leaf joints included), and a translation channel for a joint whose
 //! offset from its parent changes. The four methods pose by forward kinematics, so their
 //! clips need rotations only; a clip whose joints leave their parents' (a pose from
 //! cluster centres, say) gets translations too. Consecutive rotation keys are kept in the
@@ -39,7 +47,9 @@
 //! * `_HIERARCHY_DEPTH` (SCALAR): 0 trunk, 1 its branches, …; a leaf is its stem's depth + 1;
 //! * `_PARENT_PIVOT` (VEC3): the pivot of the element it hangs on (the trunk: its own);
 //! * `_PHASE` (SCALAR, 0…1): a random number per element (stable per tree and seed), for
-//!   Zioma's per-branch phase shift.
+//!   Zioma's per-branch phase shift;
+//! * `_LEAF_FLUTTER` (VEC3, leaves only): the leaf's swing and twist frequencies (Hz) and
+//!   flutter amplitude (rad), from [`crate::leaves::LeafFlutter`].
 //!
 //! With these an engine shader can rotate each vertex about `_PIVOT` around an axis
 //! perpendicular to `_BRANCH_AXIS` and the wind, then about `_PARENT_PIVOT`, scaling the
@@ -62,7 +72,7 @@ use crate::io::write_atomic;
 use crate::mesh::{MeshError, MeshLayout, MeshParams, RawSkin, RawVertex, SkinLayout};
 use crate::model::{NONE, RawLeaf, Tree};
 use builder::Builder;
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec3, Vec4};
 use gltf::json;
 use json::validation::{Checked::Valid, USize64};
 use rig::{Geometry, Hierarchy, Rig};
@@ -117,11 +127,14 @@ pub struct GltfOptions {
     pub max_joints: Option<usize>,
     /// Levels of detail, finest first (at least one).
     pub lods: Vec<Lod>,
+    /// A leaf joint for every joint that carries leaves, turning them in the clip (see the
+    /// module documentation); off, leaves are rigid with their joint in the clip.
+    pub leaf_joints: bool,
 }
 
 impl Default for GltfOptions {
     fn default() -> Self {
-        Self { joints: JointMode::Segment, max_joints: None, lods: DEFAULT_LODS.to_vec() }
+        Self { joints: JointMode::Segment, max_joints: None, lods: DEFAULT_LODS.to_vec(), leaf_joints: true }
     }
 }
 
@@ -150,8 +163,8 @@ pub enum GltfError {
     )]
     TooLarge { bytes: u64, limit: u64 },
     /// The clip does not belong to the tree.
-    #[error("the clip has {clip} segments per frame but the tree has {tree}")]
-    ClipMismatch { clip: usize, tree: usize },
+    #[error("the clip has {clip} {what} per frame but the tree has {tree}")]
+    ClipMismatch { clip: usize, tree: usize, what: &'static str },
     /// Writing failed.
     #[error("{path}: {message}")]
     Io { path: String, message: String },
@@ -177,8 +190,10 @@ pub struct LodReport {
 pub struct ExportReport {
     /// Per level of detail.
     pub lods: Vec<LodReport>,
-    /// Skin joints (0 for a static export).
+    /// Skin joints (0 for a static export), leaf joints included.
     pub joints: usize,
+    /// Of them, leaf joints.
+    pub leaf_joints: usize,
     /// Animation keys per channel (0 for a static export).
     pub frames: usize,
     /// Animation channels.
@@ -238,7 +253,11 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
     let n = tree.segments.len();
     if let Some(c) = clip {
         if let Some(bad) = c.joints.iter().chain(&c.acc).find(|f| f.len() != n) {
-            return Err(GltfError::ClipMismatch { clip: bad.len(), tree: n });
+            return Err(GltfError::ClipMismatch { clip: bad.len(), tree: n, what: "segments" });
+        }
+        let leaves = tree.leaves.len();
+        if let Some(bad) = c.leaves.iter().find(|f| !f.is_empty() && f.len() != leaves) {
+            return Err(GltfError::ClipMismatch { clip: bad.len(), tree: leaves, what: "leaf rotations" });
         }
         if c.frames() < 2 {
             return Err(GltfError::Param {
@@ -248,14 +267,19 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
             });
         }
     }
-    let rig = Rig::new(tree, opts.joints);
+    let rig = Rig::new(tree, opts.joints, opts.leaf_joints && clip.is_some());
     let limit = opts.max_joints.unwrap_or(MAX_JOINTS).min(MAX_JOINTS);
-    if clip.is_some() && rig.driver.len() > limit {
+    if clip.is_some() && rig.joints() > limit {
         return Err(GltfError::TooManyJoints {
-            joints: rig.driver.len(),
+            joints: rig.joints(),
             limit,
             mode: opts.joints.as_str(),
-            hint: if opts.joints == JointMode::Segment { " (try joints per stem)" } else { "" },
+            hint: match (opts.joints, rig.leaf_groups.is_empty()) {
+                (JointMode::Segment, true) => " (try joints per stem)",
+                (JointMode::Segment, false) => " with leaf joints (try joints per stem, or no leaf joints)",
+                (JointMode::Stem, false) => " with leaf joints (try no leaf joints)",
+                (JointMode::Stem, true) => "",
+            },
         });
     }
     let mut b = Builder { root: json::Root::default(), bin: Vec::new() };
@@ -325,7 +349,9 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
 
     // Skin: the armature and its joints.
     let height = tree.bounds().1.y - tree.bounds().0.y;
-    let rest: Vec<Vec3> = rig.driver.iter().map(|&s| tree.segments.start[s]).collect();
+    let rest: Vec<Vec3> =
+        rig.driver.iter().map(|&s| tree.segments.start[s]).chain(rig.leaf_groups.iter().map(|g| g.pivot)).collect();
+    let parent: Vec<u32> = rig.parent.iter().copied().chain(rig.leaf_groups.iter().map(|g| g.parent)).collect();
     let mut scene_nodes = Vec::new();
     let mut skin = None;
     let mut joint_nodes = Vec::new();
@@ -334,8 +360,8 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         let armature = b.root.push(json::Node { name: Some("armature".into()), ..Default::default() });
         scene_nodes.push(armature);
         let first = b.root.nodes.len() as u32;
-        joint_nodes = (0..rig.driver.len() as u32).map(|j| json::Index::new(first + j)).collect();
-        for (j, &p) in rig.parent.iter().enumerate() {
+        joint_nodes = (0..rig.joints() as u32).map(|j| json::Index::new(first + j)).collect();
+        for (j, &p) in parent.iter().enumerate() {
             let local = if p == NONE { rest[j] } else { rest[j] - rest[p as usize] };
             b.root.push(json::Node {
                 name: Some(rig.name(j)),
@@ -344,8 +370,8 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
             });
         }
         let mut roots = Vec::new();
-        let mut children = vec![Vec::new(); rig.driver.len()];
-        for (j, &p) in rig.parent.iter().enumerate() {
+        let mut children = vec![Vec::new(); rig.joints()];
+        for (j, &p) in parent.iter().enumerate() {
             if p == NONE { roots.push(joint_nodes[j]) } else { children[p as usize].push(joint_nodes[j]) }
         }
         b.root.nodes[armature.value()].children = Some(roots);
@@ -375,6 +401,7 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
 
     // Meshes, one per level of detail.
     let hier = Hierarchy::new(tree);
+    let flutter = rig::leaf_flutter(tree);
     let mut lods = Vec::new();
     for (k, lod) in opts.lods.iter().enumerate() {
         let params =
@@ -390,9 +417,12 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         primitives.push(b.primitive(&bark, &rig, clip.is_some(), bark_mat));
         let leaf_stride = layout.params.leaf_sides as usize + 1;
         if !layout.leaves.is_empty() {
-            let leaves = Geometry::new(&skinned.leaf_rest, &skinned.leaf_skin, &layout.leaf_indices, |v, _| {
+            let mut leaves = Geometry::new(&skinned.leaf_rest, &skinned.leaf_skin, &layout.leaf_indices, |v, _| {
                 hier.leaf(tree, &layout.leaves[v / leaf_stride])
             });
+            leaves.flutter = (0..skinned.leaf_rest.len())
+                .map(|v| flutter.get(layout.leaves[v / leaf_stride].index as usize).copied().unwrap_or_default())
+                .collect();
             primitives.push(b.primitive(&leaves, &rig, clip.is_some(), leaf_mat));
         }
         let name = format!("{}_LOD{k}", tree.name);
@@ -444,7 +474,8 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
     b.root.buffers[0].byte_length = USize64(b.bin.len() as u64);
     let report = ExportReport {
         lods,
-        joints: if clip.is_some() { rig.driver.len() } else { 0 },
+        joints: if clip.is_some() { rig.joints() } else { 0 },
+        leaf_joints: rig.leaf_groups.len(),
         frames: clip.map_or(0, |c| c.frames()),
         channels,
         texture_bytes,

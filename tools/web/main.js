@@ -1,0 +1,130 @@
+// Plays a Sylva glTF export in three.js: the tree's first level of detail, its baked clip
+// looping, an orbit camera. `?file=URL` picks the file (default tree.glb), `?lod=k` the
+// level shown, `?paused` stops the clock (the check script drives time through `probe`).
+//
+// `window.sylva` reports what was loaded and, through `probe(t)`, what the clip does at
+// time t: how far each leaf joint turns its leaves relative to the joint they hang on
+// (the leaves' own motion, see docs/GLTF.md), and the skinned positions of sample vertices.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+
+const query = new URLSearchParams(location.search);
+const file = query.get('file') ?? 'tree.glb';
+const lod = Number(query.get('lod') ?? 0);
+const paused = query.has('paused');
+const status = document.getElementById('status');
+
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(1);
+renderer.setSize(innerWidth, innerHeight);
+document.body.appendChild(renderer.domElement);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0xa9c1d6);
+scene.add(new THREE.HemisphereLight(0xdde8f4, 0x4a3f30, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 2.2);
+sun.position.set(3, 6, 4);
+scene.add(sun);
+const camera = new THREE.PerspectiveCamera(35, innerWidth / innerHeight, 0.05, 2000);
+const controls = new OrbitControls(camera, renderer.domElement);
+const clock = new THREE.Clock();
+let mixer = null;
+
+window.sylva = { ready: false, error: null };
+
+/** The angle of a rotation matrix's rotation, degrees. */
+function angleDeg(m) {
+  const q = new THREE.Quaternion().setFromRotationMatrix(new THREE.Matrix4().extractRotation(m));
+  return THREE.MathUtils.radToDeg(2 * Math.acos(Math.min(1, Math.abs(q.w))));
+}
+
+new GLTFLoader().load(file, (gltf) => {
+  const root = gltf.scene;
+  // One level of detail: `<tree>_LOD<k>` nodes other than the chosen one are hidden.
+  const lods = [];
+  root.traverse((o) => { const m = /_LOD(\d+)$/.exec(o.name); if (m) lods.push([Number(m[1]), o]); });
+  for (const [k, o] of lods) o.visible = k === lod;
+  scene.add(root);
+  root.updateMatrixWorld(true);
+  const box = new THREE.Box3().setFromObject(lods.find(([k]) => k === lod)?.[1] ?? root);
+  const centre = box.getCenter(new THREE.Vector3());
+  const size = box.getSize(new THREE.Vector3());
+  const distance = 1.2 * Math.max(size.y, size.x) / (2 * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)));
+  camera.position.set(centre.x, centre.y, centre.z + distance);
+  controls.target.copy(centre);
+  controls.update();
+
+  const shown = lods.find(([k]) => k === lod)?.[1] ?? root;
+  const skinned = [];
+  shown.traverse((o) => { if (o.isSkinnedMesh) skinned.push(o); });
+  const leaves = skinned.find((m) => m.material.name === 'leaf') ?? null;
+  const clip = gltf.animations[0] ?? null;
+  if (clip) {
+    mixer = new THREE.AnimationMixer(root);
+    mixer.clipAction(clip).play();
+  }
+  // Leaf joints and the joints they hang on, as indices into the leaf mesh's skeleton.
+  const pairs = [];
+  if (leaves) {
+    const bones = leaves.skeleton.bones;
+    const index = new Map(bones.map((b, i) => [b, i]));
+    bones.forEach((b, i) => { if (b.name.startsWith('leaves_') && index.has(b.parent)) pairs.push([i, index.get(b.parent)]); });
+  }
+
+  window.sylva = {
+    ready: true,
+    error: null,
+    clip: clip ? { name: clip.name, duration: clip.duration, tracks: clip.tracks.length } : null,
+    lods: lods.length,
+    visibleLods: lods.filter(([, o]) => o.visible).length,
+    leafJoints: pairs.length,
+    renderer: renderer.getContext().getParameter(renderer.getContext().VERSION),
+    /** Poses the clip at `t` seconds, renders, and reports the leaves' turn and samples. */
+    probe(t, samples = 64) {
+      if (mixer) mixer.setTime(t);
+      scene.updateMatrixWorld(true);
+      renderer.render(scene, camera);
+      const out = { t, leafTurnDeg: [], vertices: [] };
+      if (!leaves) return out;
+      const s = leaves.skeleton;
+      s.update();
+      const skin = (i) => new THREE.Matrix4().multiplyMatrices(s.bones[i].matrixWorld, s.boneInverses[i]);
+      for (const [leaf, parent] of pairs) {
+        out.leafTurnDeg.push(angleDeg(skin(parent).invert().multiply(skin(leaf))));
+      }
+      const n = leaves.geometry.attributes.position.count;
+      const v = new THREE.Vector3();
+      for (let k = 0; k < samples; k++) {
+        const i = Math.floor((k + 0.5) * n / samples);
+        leaves.getVertexPosition(i, v);
+        out.vertices.push(v.toArray());
+      }
+      return out;
+    },
+    /** The canvas's pixels (RGBA rows), for comparing two renders. */
+    pixels() {
+      const gl = renderer.getContext();
+      const px = new Uint8Array(gl.drawingBufferWidth * gl.drawingBufferHeight * 4);
+      gl.readPixels(0, 0, gl.drawingBufferWidth, gl.drawingBufferHeight, gl.RGBA, gl.UNSIGNED_BYTE, px);
+      return px;
+    },
+  };
+  status.textContent = `${file}: ${clip ? `clip “${clip.name}”, ${clip.duration.toFixed(2)} s` : 'static'}, ${pairs.length} leaf joints`;
+}, undefined, (e) => {
+  window.sylva = { ready: false, error: String(e?.message ?? e) };
+  status.textContent = `could not load ${file}: ${window.sylva.error}`;
+  console.error(window.sylva.error);
+});
+
+addEventListener('resize', () => {
+  camera.aspect = innerWidth / innerHeight;
+  camera.updateProjectionMatrix();
+  renderer.setSize(innerWidth, innerHeight);
+});
+
+renderer.setAnimationLoop(() => {
+  const dt = clock.getDelta();
+  if (mixer && !paused) mixer.update(dt);
+  controls.update();
+  renderer.render(scene, camera);
+});
