@@ -317,8 +317,10 @@ fn max_speed(s: &HsmState) -> f32 {
 
 /// Song's central claim, stability, in a hurricane on the whole stochastic bush: ten
 /// simulated minutes (36,000 steps) of 60 m/s wind with the `gusty` preset's turbulence at
-/// 12 m/s keep every particle finite and slower than twice the wind, the pose sound; a
-/// minute after the wind stops the bush is back within 1 % of its height of rest.
+/// 12 m/s keep every particle finite and slower than twice the wind, the pose sound and
+/// every leaf's rotation a finite unit quaternion; a minute after the wind stops the bush
+/// is back within 1 % of its height of rest and every leaf within 1° of its rest on its
+/// segment.
 #[test]
 fn ten_minutes_of_hurricane_stay_stable_and_recover() {
     let t = tree("stochastic_bush");
@@ -332,9 +334,19 @@ fn ten_minutes_of_hurricane_stay_stable_and_recover() {
     let fw = wind.packed();
     let mut s = h.state_at_rest();
     let rest = s.clone();
+    let mut seam = sylva_core::pose::SeamPose::default();
+    let mut turned = 0.0f32;
+    assert!(t.leaves.len() > 50);
     for k in 0..36_000 {
         h.step_packed(&fw.fields, &fw.waves, &mut s, 1.0 / 60.0);
         if k % 3_000 == 0 || k == 35_999 {
+            h.seam(&t, &fw, &s, &mut seam);
+            assert_eq!(seam.leaf.len(), t.leaves.len());
+            for q in &seam.leaf {
+                let q = Quat::from_array(*q);
+                assert!(q.is_finite() && (q.length() - 1.0).abs() < 1e-3, "step {k}: a leaf rotation {q}");
+                turned = turned.max(2.0 * q.w.abs().min(1.0).acos());
+            }
             assert!(s.displacement.iter().all(|p| p.iter().all(|v| v.is_finite())), "step {k}: NaN");
             let v = max_speed(&s);
             assert!(v < 120.0, "step {k}: a particle at {v} m/s");
@@ -349,6 +361,11 @@ fn ten_minutes_of_hurricane_stay_stable_and_recover() {
     }
     let d = s.max_distance(&rest);
     assert!(d <= 0.01 * t.height(), "a minute after the hurricane a particle is {d} m from rest");
+    assert!(turned > 0.5, "the hurricane turned no leaf ({turned} rad)");
+    h.seam(&t, &PackedWind::calm(), &s, &mut seam);
+    let leaf = seam.leaf.iter().map(|q| 2.0 * q[3].abs().min(1.0).acos()).fold(0.0, f32::max).to_degrees();
+    println!("leaves: at most {:.1}° in the hurricane, {leaf:.3}° a minute after it", turned.to_degrees());
+    assert!(leaf <= 1.0, "a minute after the hurricane a leaf is {leaf}° from rest");
 }
 
 /// Every preset (its first 600 clusters, grown from the root): a 1,000-step storm stays

@@ -141,7 +141,7 @@ kernels! {
     hsm_integrate: [QUAT, HSM, HSM_ADVANCE, HSM_INTEGRATE] => sylva_core::methods::hsm::kernels::hsm_integrate;
     hsm_particles: [QUAT, HSM, HSM_GATHER, HSM_ADVANCE, HSM_PARTICLES] => sylva_core::methods::hsm::kernels::hsm_particles;
     hsm_pose: [QUAT, TREE, HSM, HSM_POSE] => sylva_core::methods::hsm::kernels::hsm_pose;
-    hsm_leaf_pose: [QUAT, TREE, HSM, HSM_LEAF_POSE] => sylva_core::methods::hsm::kernels::hsm_leaf_pose;
+    hsm_leaf_pose: [QUAT, HSM, HSM_LEAF_POSE] => sylva_core::methods::hsm::kernels::hsm_leaf_pose;
     leaf_wind: [QUAT, NOISE, WIND, LEAVES, LEAF_WIND] => sylva_core::leaves::kernels::leaf_wind;
     leaf_flutter: [QUAT, NOISE, LEAVES, LEAF_FLUTTER] => sylva_core::leaves::kernels::leaf_flutter;
     mesh_tubes: [QUAT, TREE, NOISE, MESH, MESH_TUBES] => sylva_core::mesh::mesh_tubes;

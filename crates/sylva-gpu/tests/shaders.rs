@@ -377,7 +377,7 @@ fn animation_structs_match_their_wgsl_twins() {
 #[test]
 fn hsm_structs_match_their_wgsl_twins() {
     use sylva_core::methods::hsm::{
-        RawHsmCluster, RawHsmClusterInfo, RawHsmClusterState, RawHsmMember, RawHsmSlot, RawHsmStep,
+        RawHsmCluster, RawHsmClusterInfo, RawHsmClusterState, RawHsmLeaf, RawHsmMember, RawHsmSlot, RawHsmStep,
     };
     use sylva_gpu::shaders::{HSM, QUAT};
     let hsm = compose(&[QUAT, HSM]);
@@ -410,6 +410,23 @@ fn hsm_structs_match_their_wgsl_twins() {
         "HsmSlot",
         size_of::<RawHsmSlot>(),
         &[("q", offset_of!(RawHsmSlot, q)), ("particle", offset_of!(RawHsmSlot, particle))],
+    );
+    check_in(
+        &hsm,
+        "HsmLeaf",
+        size_of::<RawHsmLeaf>(),
+        &[
+            ("tip", offset_of!(RawHsmLeaf, tip)),
+            ("segment", offset_of!(RawHsmLeaf, segment)),
+            ("edge", offset_of!(RawHsmLeaf, edge)),
+            ("slot_offset", offset_of!(RawHsmLeaf, slot_offset)),
+            ("attach", offset_of!(RawHsmLeaf, attach)),
+            ("cluster", offset_of!(RawHsmLeaf, cluster)),
+            ("ring", offset_of!(RawHsmLeaf, ring)),
+            ("blade", offset_of!(RawHsmLeaf, blade)),
+            ("strength", offset_of!(RawHsmLeaf, strength)),
+            ("_pad", offset_of!(RawHsmLeaf, _pad)),
+        ],
     );
     check_in(
         &hsm,

@@ -173,17 +173,26 @@ impl Forest {
                     // A method without per-instance poses: every copy takes the one pose.
                     a.seam(&mut self.one);
                     let n = self.placements.len();
-                    self.seam.joints = self.one.joints.iter().cycle().take(n * tree.segments.len()).copied().collect();
-                    self.seam.acc = self.one.acc.iter().cycle().take(n * tree.segments.len()).copied().collect();
+                    let total = n * tree.segments.len();
+                    self.seam.joints.clear();
+                    self.seam.joints.extend(self.one.joints.iter().cycle().take(total));
+                    self.seam.acc.clear();
+                    self.seam.acc.extend(self.one.acc.iter().cycle().take(total));
                     self.seam.leaf.clone_from(&self.one.leaf);
                 }
                 ctx.queue.write_buffer(&self.joint, 0, bytemuck::cast_slice(&self.seam.joints));
                 ctx.queue.write_buffer(&self.acc, 0, bytemuck::cast_slice(&self.seam.acc));
-                let identity = [0.0f32, 0.0, 0.0, 1.0];
-                let leaves: Vec<[f32; 4]> =
-                    (0..tree.leaves.len()).map(|l| self.seam.leaf.get(l).copied().unwrap_or(identity)).collect();
-                if !leaves.is_empty() {
-                    ctx.queue.write_buffer(&self.leaf, 0, bytemuck::cast_slice(&leaves));
+                // The first instance's leaf rotations; fewer than the leaves (none: at rest)
+                // leave the rest at the identity.
+                let leaves = tree.leaves.len();
+                if leaves > 0 {
+                    if let Some(all) = self.seam.leaf.get(..leaves) {
+                        ctx.queue.write_buffer(&self.leaf, 0, bytemuck::cast_slice(all));
+                    } else {
+                        let identity = [0.0f32, 0.0, 0.0, 1.0];
+                        self.seam.leaf.resize(leaves, identity);
+                        ctx.queue.write_buffer(&self.leaf, 0, bytemuck::cast_slice(&self.seam.leaf));
+                    }
                 }
                 self.skin.record_with_leaves(ctx, encoder, &self.joint, &self.acc, &self.leaf);
             }

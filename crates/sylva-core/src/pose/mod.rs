@@ -255,3 +255,17 @@ impl Placement {
         self.position + Vec3::new(c * p.x + s * p.z, p.y, -s * p.x + c * p.z)
     }
 }
+
+/// The rotation taking unit `a` onto unit `b`, `normalize(a × b, 1 + a·b)`: exactly the
+/// identity when `a == b` (tested, not left to `a × a`, which a fused multiply-add leaves at
+/// the rounding error of a product instead of zero), and faithful for tiny angles (no
+/// snapping to the identity). Falls back to the identity for a zero vector or opposite
+/// directions. The WGSL twin is `shortest_arc` in `quat.wgsl`.
+pub fn shortest_arc(a: Vec3, b: Vec3) -> Quat {
+    let w = 1.0 + a.dot(b);
+    if a == b || a == Vec3::ZERO || b == Vec3::ZERO || w < 1e-6 {
+        return Quat::IDENTITY;
+    }
+    let c = a.cross(b);
+    Quat::from_xyzw(c.x, c.y, c.z, w).normalize()
+}

@@ -29,24 +29,13 @@ struct LeafMotion {
     _pad: u32,
 }
 
-fn leaf_smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
-    let t = clamp((x - e0) / (e1 - e0), 0.0, 1.0);
-    return t * t * (3.0 - 2.0 * t);
-}
-
-// sin of a large argument, reduced by whole turns first (as wind.wgsl's sin_turns).
-fn leaf_sin(x: f32) -> f32 {
-    let turns = round(x * (0.5 / 3.141592653589793));
-    return sin(x - turns * 6.28125 - turns * 0.0019353072);
-}
-
 // Unit-RMS narrow-band flutter: three sines over the half-power band omega (1 ± zeta).
 fn leaf_band(omega: f32, zeta: f32, t: f32, seed: u32) -> f32 {
     var sum = 0.0;
     for (var j = 0u; j < 3u; j++) {
         let w = omega * (1.0 + zeta * (f32(j) - 1.0));
         let phase = hash_unit(seed + j) * 6.283185307179586;
-        sum += leaf_sin(w * t + phase);
+        sum += sin_turns(w * t + phase);
     }
     return sum * 0.8164966;
 }
@@ -76,7 +65,7 @@ fn leaf_rotation(frame: LeafFrame, m: LeafMotion, w: vec4<f32>, s2: vec4<f32>, d
     let omega = m.omega * damped;
     let omega_twist = m.omega_twist * damped;
     let pitch = frame.strength * (phi * s + amp * leaf_band(omega, frame.zeta, t, m.seed));
-    let tumble = 0.7853981633974483 * leaf_smoothstep(0.8, 1.25, q_twig / m.flip_pressure);
+    let tumble = 0.7853981633974483 * smooth_step(0.8, 1.25, q_twig / m.flip_pressure);
     let twist = frame.strength * ((amp + tumble) * leaf_band(omega_twist, frame.zeta, t, m.seed + 3u));
     let hp = 0.5 * pitch;
     let ht = 0.5 * twist;

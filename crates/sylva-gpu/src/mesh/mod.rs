@@ -178,11 +178,16 @@ impl GpuMesh {
         debug_assert_eq!(seam.joints.len(), self.segment_count);
         ctx.queue.write_buffer(&self.joint, 0, bytemuck::cast_slice(&seam.joints));
         ctx.queue.write_buffer(&self.acc, 0, bytemuck::cast_slice(&seam.acc));
-        let identity = [0.0f32, 0.0, 0.0, 1.0];
-        let leaves: Vec<[f32; 4]> =
-            (0..self.leaf_slots).map(|l| seam.leaf.get(l).copied().unwrap_or(identity)).collect();
-        if !leaves.is_empty() {
-            ctx.queue.write_buffer(&self.leaf_rotation, 0, bytemuck::cast_slice(&leaves));
+        if self.leaf_slots > 0 {
+            if let Some(all) = seam.leaf.get(..self.leaf_slots) {
+                ctx.queue.write_buffer(&self.leaf_rotation, 0, bytemuck::cast_slice(all));
+            } else {
+                // Fewer rotations than leaves (none: at rest): the rest take the identity.
+                let identity = [0.0f32, 0.0, 0.0, 1.0];
+                let leaves: Vec<[f32; 4]> =
+                    (0..self.leaf_slots).map(|l| seam.leaf.get(l).copied().unwrap_or(identity)).collect();
+                ctx.queue.write_buffer(&self.leaf_rotation, 0, bytemuck::cast_slice(&leaves));
+            }
         }
         self.record(ctx, encoder, &self.joint, &self.acc);
     }

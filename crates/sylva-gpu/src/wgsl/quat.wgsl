@@ -52,3 +52,13 @@ fn quat_slerp(a: vec4<f32>, b_in: vec4<f32>, t: f32) -> vec4<f32> {
     let s = 1.0 / sin(theta);
     return normalize(a * (sin((1.0 - t) * theta) * s) + b * (sin(t * theta) * s));
 }
+
+// Rotation taking unit a onto unit b: normalize(a x b, 1 + a.b); exactly the identity when
+// a == b (tested: with fused multiply-adds a x a is a product's rounding error, not zero).
+fn shortest_arc(a: vec3<f32>, b: vec3<f32>) -> vec4<f32> {
+    let w = 1.0 + dot(a, b);
+    if (all(a == b) || all(a == vec3<f32>(0.0)) || all(b == vec3<f32>(0.0)) || w < 1e-6) {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    return normalize(vec4<f32>(cross(a, b), w));
+}

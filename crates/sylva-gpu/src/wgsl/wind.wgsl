@@ -30,22 +30,6 @@ struct Wave {
 @group(0) @binding(0) var<storage, read> wind_fields: array<Field>;
 @group(0) @binding(1) var<storage, read> wind_waves: array<Wave>;
 
-// sin of a wave's phase, reduced to [-pi, pi] by whole turns first (2pi in two parts, so
-// the reduction is exact for the phases the wind produces). A GPU's own sin of a large
-// argument reduces it in single precision (NVIDIA's: an error that grows with |x|, ~6e-5 at
-// 1,500 rad, and the same at the next step, so a simulation drifts by it); reduced, it is
-// within ~1e-6 of the CPU's correctly rounded sine. The CPU's sixteen-lane twin
-// (sylva_core::wind::lanes::sin) reduces the same way.
-fn sin_turns(x: f32) -> f32 {
-    let turns = round(x * (0.5 / 3.141592653589793));
-    return sin(x - turns * 6.28125 - turns * 0.0019353072);
-}
-
-fn smooth_step(e0: f32, e1: f32, x: f32) -> f32 {
-    let t = clamp((x - e0) / (e1 - e0), 0.0, 1.0);
-    return t * t * (3.0 - 2.0 * t);
-}
-
 // A wave field's blend in and out (`wave_envelope` in wind/sample.rs): exactly 1 without fades.
 fn wave_envelope(b: vec4<f32>, t: f32) -> f32 {
     return smooth_step(0.0, 1.0, (t - b.x) * b.y) * (1.0 - smooth_step(0.0, 1.0, (t - b.z) * b.w));

@@ -110,6 +110,8 @@ impl HsmLayout {
         let mut stiffness: Vec<(f32, f32)> = Vec::with_capacity(total_clusters);
         let pi = std::f32::consts::PI;
         let r_mech = crate::physics::mechanical_radii(tree, params.min_radius);
+        // Each leaf's petiole swing, as the closed form's (phases unused).
+        let petioles = crate::leaves::LeafFlutter::new(tree, 0);
         #[allow(clippy::needless_range_loop)] // i indexes every per-segment array of the tree
         'segments: for i in 0..s.len() {
             if b.layout.info.len() >= total_clusters {
@@ -215,7 +217,8 @@ impl HsmLayout {
                     slot_count: slot_particles.len() as u32 - slot_offset,
                 });
                 parents.push(c);
-                stiffness.push((params.leaf_stiffness, 0.0));
+                let omega = petioles.leaves.get(leaf).map_or(0.0, |m| m.omega);
+                stiffness.push((omega * omega * params.leaf_stiffness, 0.0));
             }
         }
         // Song's global level (Fig. 4): one more cluster per stem over all its segments'
@@ -309,7 +312,22 @@ impl HsmLayout {
             let cmf = cm.as_vec3();
             // A segment's k = K / (μ ρ²), ρ² = tr(Aqq) / M its squared radius of gyration.
             let (kk, mu) = stiffness[c];
-            let kc = if mu > 0.0 { kk / (mu * (scale / msum) as f32).max(1e-30) } else { kk };
+            let mut kc = if mu > 0.0 { kk / (mu * (scale / msum) as f32).max(1e-30) } else { kk };
+            if info.kind == kind::LEAF {
+                // The cluster's R turns with the blade by the blade's share `f` of its
+                // moment of inertia, so the blade's spring pulls on `1 − f` of its turn: the
+                // rate `ω² / (1 − f)` swings it at the petiole's ω (`1 − f` at least 0.05).
+                let blade = (info.slot_count - params.leaf_particles) as usize;
+                let j = |ps: &[u32]| -> f64 {
+                    ps.iter()
+                        .map(|&p| {
+                            b.layout.mass[p as usize] as f64 * (b.pos[p as usize].as_dvec3() - cm).length_squared()
+                        })
+                        .sum()
+                };
+                let (jr, jb) = (j(&run[..blade]), j(&run[blade..]));
+                kc /= ((jr / (jr + jb).max(1e-30)) as f32).max(0.05);
+            }
             clusters.push(RawHsmCluster {
                 rest_cm: [cmf.x, cmf.y, cmf.z, kc],
                 parent: parents[c],

@@ -9,7 +9,14 @@
 //!   stem's next segment — Song's head-to-tail link). The root's first ring is its own and
 //!   **fixed** (the tree stands in the ground).
 //! * A **leaf cluster** is the nearest ring of its segment's cluster (shared) plus
-//!   `leaf_particles` points on the blade (its tip, then points along an edge).
+//!   `leaf_particles` points on the blade (its tip, then points along an edge). Its rate is
+//!   its petiole's swing `ω²`, the closed form's ([`crate::leaves::leaf_constants`]: from
+//!   the blade and the species' `[leaf_motion]`, above its twig's mode), over `1 − f`, `f`
+//!   the blade's share of the cluster's moment of inertia (R turns with the blade by about
+//!   `f`, so its spring pulls on the rest), so a leaf swings near the same frequency in
+//!   every method. The pose seam's leaf rotation is where the blade
+//!   points: [`kernels::hsm_leaf_pose`] reads the tip and edge particles in the cluster's
+//!   frame.
 //! * Particles are the simulation's proxies, not the bark: a ring's radius is the segment's
 //!   radius but never less than `ring_ratio × length`, because a joint resists bending
 //!   through the lever of its shared ring and a 2 mm twig ring would have none. Mass and
@@ -109,6 +116,7 @@ use crate::model::{NONE, Tree};
 use crate::pose::{Pose, SeamPose};
 use crate::wind::PackedWind;
 use crate::wind::raw::{RawField, RawWave};
+use bytemuck::Zeroable;
 use glam::Vec3;
 use kernels::{hsm_goals, hsm_integrate, hsm_leaf_pose, hsm_pose};
 use runs::{HsmRuns, avx2_at, hsm_particles_runs};
@@ -151,7 +159,9 @@ pub struct HsmParams {
     /// Thinnest radius used for a joint's bending stiffness, m (as
     /// [`super::akagi::AkagiParams::min_radius`]). Default 1.5 mm.
     pub min_radius: f32,
-    /// Stiffness of leaf clusters, 1/s². Default 900 (30 rad/s): leaves flutter.
+    /// Scale of the leaf clusters' rates: a leaf's rate is its petiole's swing `ω²` (the
+    /// closed form's [`crate::leaves::leaf_constants`], from the blade and the species'
+    /// `[leaf_motion]`, above its twig's mode) times this. Default 1.
     pub leaf_stiffness: f32,
     /// Structural damping ratio ζ of the trunk's first mode: velocities are damped at the
     /// rate `c = 2 ζ ω₀` (`v *= e^{−c h}` each substep), ω₀ the trunk's frequency from the
@@ -208,7 +218,7 @@ pub struct HsmParams {
     /// `√stiffness_scale`): HSM's trunk is plucked once when the method is built and its
     /// frequency measured (see [`calibrate`]). Default true: shape matching's clusters have
     /// a rate each but no modulus, and their ring levers make a chain of them stiffer than
-    /// the beam it stands for. Leaves keep [`Self::leaf_stiffness`]. Needs `substep_rate > 0`.
+    /// the beam it stands for. Leaves keep their petioles' rates. Needs `substep_rate > 0`.
     pub calibrate: bool,
 }
 
@@ -223,7 +233,7 @@ impl Default for HsmParams {
             leaf_particles: 2,
             stiffness_scale: 1.0,
             min_radius: 0.0015,
-            leaf_stiffness: 900.0,
+            leaf_stiffness: 1.0,
             damping_ratio: crate::physics::STRUCTURAL_DAMPING,
             drag: 0.8,
             leaf_drag: 0.05,
@@ -382,6 +392,8 @@ pub struct Hsm {
     rest_joints: Vec<[f32; 4]>,
     /// Cluster of each leaf of the tree (`u32::MAX` where a truncated layout has none).
     pub leaf_cluster: Vec<u32>,
+    /// Each leaf's blade in the particles, for [`kernels::hsm_leaf_pose`].
+    pub leaves: Vec<RawHsmLeaf>,
 }
 
 impl Hsm {
@@ -419,12 +431,36 @@ impl Hsm {
         let runs = HsmRuns::new(&layout);
         let groups = HsmSlotGroups::new(&layout);
         let mut leaf_cluster = vec![NONE; tree.leaves.len()];
+        let mut leaves: Vec<RawHsmLeaf> = tree
+            .leaves
+            .segment
+            .iter()
+            .map(|&segment| RawHsmLeaf { segment, strength: tree.leaf_motion.strength, ..RawHsmLeaf::zeroed() })
+            .collect();
+        let blade = params.leaf_particles;
         for (c, info) in layout.info.iter().enumerate() {
-            if info.kind == kind::LEAF && (info.source as usize) < leaf_cluster.len() {
+            if info.kind == kind::LEAF && (info.source as usize) < leaf_cluster.len() && info.slot_count > blade {
                 leaf_cluster[info.source as usize] = c as u32;
+                let ring = info.slot_count - blade;
+                let at = |j: u32| {
+                    let p = layout.slots[(info.slot_offset + j) as usize].particle as usize;
+                    Vec3::from_slice(&layout.rest[p][..3])
+                };
+                let centre = (0..ring).map(at).sum::<Vec3>() / ring as f32;
+                let attach = tree.leaves.position[info.source as usize];
+                let lf = &mut leaves[info.source as usize];
+                lf.slot_offset = info.slot_offset;
+                lf.cluster = c as u32;
+                lf.ring = ring;
+                lf.blade = blade;
+                lf.attach = (attach - centre).to_array();
+                lf.tip = (at(ring) - attach).to_array();
+                if blade > 1 {
+                    lf.edge = (at(ring + 1) - attach).to_array();
+                }
             }
         }
-        Self { params, layout, runs, groups, rest_joints, leaf_cluster }
+        Self { params, layout, runs, groups, rest_joints, leaf_cluster, leaves }
     }
 
     /// The state at rest (without prestress, gravity has yet to sag it: see [`Self::settle`]).
@@ -537,12 +573,12 @@ impl Hsm {
         acc
     }
 
-    /// Each leaf's rotation in its segment's rest frame: its cluster's R turned back by its
-    /// segment's, `R_s⁻¹ R_leaf` (Song §4: a leaf is a cluster of its own). `acc` holds
-    /// the segments' rotations ([`Self::rotations`]).
-    pub fn leaf_rotations(&self, tree: &Tree, state: &HsmState, acc: &[[f32; 4]], out: &mut Vec<[f32; 4]>) {
-        out.resize(self.leaf_cluster.len(), [0.0, 0.0, 0.0, 1.0]);
-        hsm_leaf_pose(&tree.leaves.segment, &self.leaf_cluster, &state.clusters, acc, out);
+    /// Each leaf's rotation in its segment's rest frame, from its blade's particles (Song
+    /// §4: a leaf is a cluster of its own; see [`kernels::hsm_leaf_pose`]). `acc` holds
+    /// the segments' rotations.
+    pub fn leaf_rotations(&self, state: &HsmState, acc: &[[f32; 4]], out: &mut Vec<[f32; 4]>) {
+        out.resize(self.leaves.len(), [0.0, 0.0, 0.0, 1.0]);
+        hsm_leaf_pose(&self.leaves, &self.layout.slots, &state.displacement, &state.clusters, acc, out);
     }
 
     /// Where each segment cluster's own transform puts its segment's joint,
@@ -612,7 +648,7 @@ impl Method for Hsm {
         out.acc = self.rotations(state);
         out.joints.resize(out.acc.len(), [0.0; 4]);
         crate::pose::fk::positions_forward(&tree.segments.parent, &self.rest_joints, &out.acc, &mut out.joints);
-        self.leaf_rotations(tree, state, &out.acc, &mut out.leaf);
+        self.leaf_rotations(state, &out.acc, &mut out.leaf);
     }
 
     /// Segments turned by their clusters' rotations, joints by forward kinematics.

@@ -128,3 +128,31 @@ pub struct RawHsmStep {
 
 /// [`super::HsmState::velocity`]'s w for a fixed particle (free ones carry their drag factor ≥ 0).
 pub const FIXED: f32 = -1.0;
+
+/// One leaf's blade in the particles, 64 bytes: what [`super::kernels::hsm_leaf_pose`] turns
+/// into the leaf's rotation. WGSL: `HsmLeaf`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawHsmLeaf {
+    /// Rest offset of the blade's tip from the leaf's attachment, m.
+    pub tip: [f32; 3],
+    /// The segment it hangs on.
+    pub segment: u32,
+    /// Rest offset of the blade's edge point from the attachment, m (zero with one blade
+    /// particle).
+    pub edge: [f32; 3],
+    /// First slot of its leaf cluster: the ring's slots, then the blade's (tip, edge, …).
+    pub slot_offset: u32,
+    /// Rest offset of the attachment from the centre of the leaf cluster's ring, m.
+    pub attach: [f32; 3],
+    /// Its leaf cluster.
+    pub cluster: u32,
+    /// Ring slots (0: the leaf has no cluster and stays at rest).
+    pub ring: u32,
+    /// Blade slots.
+    pub blade: u32,
+    /// Scale of the leaf's turn, the tree's `leaf_motion.strength` (0: rigid on its segment).
+    pub strength: f32,
+    /// Padding.
+    pub _pad: u32,
+}

@@ -133,19 +133,7 @@ fn segment_rotation(param: [f32; 4], stems: &[RawSkjermoStem], state: &[RawSkjer
     shortest_arc(a, b)
 }
 
-/// The rotation taking unit `a` onto unit `b`, `normalize(a × b, 1 + a·b)`: exactly the
-/// identity when `a == b` (tested, not left to `a × a`, which a fused multiply-add leaves at
-/// the rounding error of a product instead of zero), and faithful for tiny angles (no
-/// snapping to the identity). Falls back to the identity for a zero vector or opposite
-/// directions.
-pub fn shortest_arc(a: Vec3, b: Vec3) -> Quat {
-    let w = 1.0 + a.dot(b);
-    if a == b || a == Vec3::ZERO || b == Vec3::ZERO || w < 1e-6 {
-        return Quat::IDENTITY;
-    }
-    let c = a.cross(b);
-    Quat::from_xyzw(c.x, c.y, c.z, w).normalize()
-}
+pub use crate::pose::shortest_arc;
 
 /// Per-segment seam rotations δᵢ = R_parent⁻¹ Rᵢ, so that the seam's accumulated rotation of
 /// every segment is its own Rᵢ. Bindings: 0 segment params, 1 stems, 2 state, 3 parents,

@@ -27,6 +27,20 @@ struct HsmSlot {
     particle: u32,
 }
 
+// CPU twin: sylva_core::methods::hsm::RawHsmLeaf.
+struct HsmLeaf {
+    tip: vec3<f32>,
+    segment: u32,
+    edge: vec3<f32>,
+    slot_offset: u32,
+    attach: vec3<f32>,
+    cluster: u32,
+    ring: u32,
+    blade: u32,
+    strength: f32,
+    _pad: u32,
+}
+
 struct HsmMember {
     q: vec3<f32>,
     cluster: u32,

@@ -43,8 +43,7 @@ pub struct GpuHsm {
     member: wgpu::Buffer,
     segment_cluster: wgpu::Buffer,
     leaf_pose_kernel: Arc<Kernel>,
-    leaf_segment: wgpu::Buffer,
-    leaf_cluster: wgpu::Buffer,
+    leaves: wgpu::Buffer,
     /// The substep parameters of the current submission, one after another.
     steps: wgpu::Buffer,
     steps_capacity: usize,
@@ -96,8 +95,7 @@ impl GpuHsm {
             member: upload(ctx, "hsm members", &l.member)?,
             segment_cluster: upload(ctx, "hsm segment clusters", &l.segment_cluster)?,
             leaf_pose_kernel: Kernel::get(ctx, "hsm_leaf_pose"),
-            leaf_segment: upload(ctx, "hsm leaf segments", tree.as_ref().map_or(&[][..], |t| &t.leaves.segment[..]))?,
-            leaf_cluster: upload(ctx, "hsm leaf clusters", &method.leaf_cluster)?,
+            leaves: upload(ctx, "hsm leaves", &method.leaves)?,
             steps: upload(ctx, "hsm substeps", &vec![step; method.params.substeps as usize])?,
             steps_capacity: method.params.substeps as usize,
             step: upload(ctx, "hsm step", &[step])?,
@@ -233,12 +231,19 @@ impl GpuHsm {
                 pose.segment_count() as u32,
             );
             pose.record_positions(ctx, e);
-            if !self.method.leaf_cluster.is_empty() {
+            if !self.method.leaves.is_empty() {
                 self.leaf_pose_kernel.record(
                     ctx,
                     e,
-                    &[&self.leaf_segment, &self.leaf_cluster, &self.state, pose.acc_buffer(), pose.leaf_buffer()],
-                    self.method.leaf_cluster.len() as u32,
+                    &[
+                        &self.leaves,
+                        &self.slots,
+                        &self.displacement,
+                        &self.state,
+                        pose.acc_buffer(),
+                        pose.leaf_buffer(),
+                    ],
+                    self.method.leaves.len() as u32,
                 );
             }
         }
