@@ -104,6 +104,7 @@
 pub mod calibrate;
 pub mod kernels;
 pub mod layout;
+pub mod leaf_pose;
 pub mod raw;
 pub mod runs;
 pub mod slot_groups;
