@@ -34,7 +34,7 @@ pub struct ExportArgs {
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     pub fps: f32,
     /// Make the clip loop seamlessly: the ends are cross-faded over `--blend` seconds.
-    #[arg(long = "loop", default_value_t = false)]
+    #[arg(long = "loop", default_value_t = false, conflicts_with = "static_only")]
     pub looped: bool,
     /// Cross-fade window of a looping clip, s.
     #[arg(long, default_value_t = BakeParams::default().blend, allow_negative_numbers = true)]
@@ -49,11 +49,11 @@ pub struct ExportArgs {
     #[arg(long = "static", default_value_t = false)]
     pub static_only: bool,
     /// Joints of the skin.
-    #[arg(long, value_enum, default_value = "segment")]
+    #[arg(long, value_enum, default_value = "segment", conflicts_with = "static_only")]
     pub joints: Joints,
     /// Refuse to write a skin with more joints than this (your engine's bone limit), leaf
     /// joints included.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "static_only")]
     pub max_joints: Option<usize>,
     /// No leaf joints: leaves stay rigid with their branch in the clip (their flutter is
     /// still in the `_LEAF_FLUTTER` attribute, for an engine shader).
@@ -181,9 +181,10 @@ pub fn export(
     }
     if let Some(c) = &clip {
         println!(
-            "  skin: {} joints ({} of them leaf joints); animation `wind`: {} keys ({:.2} s at {} fps{}), {} channels, {:.2} MiB",
+            "  skin: {} joints ({} of them leaf joints); animation `{}`: {} keys ({:.2} s at {} fps{}), {} channels, {:.2} MiB",
             report.joints,
             report.leaf_joints,
+            if c.looped { "wind_loop" } else { "wind" },
             report.frames,
             c.duration(),
             c.fps,

@@ -739,7 +739,7 @@ fn export_writes_a_looping_glb_and_reports_every_lod() {
     for lod in ["  0 ", "  1 ", "  2 "] {
         assert!(out.lines().any(|l| l.starts_with(lod)), "LOD row `{lod}` missing:\n{out}");
     }
-    assert!(out.contains("21 keys") && out.contains("looping"), "{out}");
+    assert!(out.contains("21 keys") && out.contains("looping") && out.contains("`wind_loop`"), "{out}");
     // Joints: one per segment and a leaf joint per leaf-bearing segment.
     let joints = |out: &str| -> (usize, usize) {
         let line = out.lines().find(|l| l.contains("skin:")).unwrap_or_else(|| panic!("no skin line:\n{out}"));
@@ -779,6 +779,9 @@ fn export_rejects_bad_input_and_leaves_no_file() {
         (&["--out", "/proc/sylva/tree.glb"], "/proc/sylva"),
         (&["--loop", "--seconds", "1", "--blend", "0.9"], "`blend` = 0.9"),
         (&["--static", "--no-leaf-joints"], "cannot be used with"),
+        (&["--static", "--loop"], "cannot be used with"),
+        (&["--static", "--joints", "stem"], "cannot be used with"),
+        (&["--static", "--max-joints", "64"], "cannot be used with"),
     ];
     for (args, expect) in cases {
         let mut all = vec!["export", "--species", "palm"];

@@ -505,6 +505,10 @@ fn looping_clip_is_seamless_in_pose_and_angular_velocity() {
     let looped = clip(&t, "akagi", 3.0, true);
     let cut = clip(&t, "akagi", 3.0, false);
     let rb = read_back(&glb(&t, Some(&looped), &GltfOptions::default()));
+    // Named so that Godot's importer loops it (a name ending in `loop`); a cut clip is not.
+    let name = |c: &Clip| build_gltf(&t, Some(c), &GltfOptions::default()).unwrap().root.animations[0].name.clone();
+    assert_eq!(name(&looped).as_deref(), Some("wind_loop"));
+    assert_eq!(name(&cut).as_deref(), Some("wind"));
     let n = looped.frames() - 1;
     assert_eq!(n, 90);
     assert!(!rb.rotation.is_empty());

@@ -29,7 +29,7 @@
 //!
 //! # Animation
 //!
-//! One clip, `wind`, with a key per frame of the [`Clip`] (linear interpolation): a
+//! One clip, `wind` (`wind_loop` when it loops: the suffix Godot's importer loops by), with a key per frame of the [`Clip`] (linear interpolation): a
 //! rotation channel per joint that moves (leaf joints included), and a translation channel for a joint whose
 //! offset from its parent changes. The four methods pose by forward kinematics, so their
 //! clips need rotations only; a clip whose joints leave their parents' (a pose from
@@ -453,7 +453,7 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         let (samplers, chans) = b.animation(tree, c, &rig, &joint_nodes, height)?;
         channels = chans.len();
         b.root.push(json::Animation {
-            name: Some("wind".into()),
+            name: Some(if c.looped { "wind_loop" } else { "wind" }.into()),
             channels: chans,
             samplers,
             extensions: None,
