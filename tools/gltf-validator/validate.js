@@ -1,6 +1,6 @@
 #!/usr/bin/env node
 // Validates glTF 2.0 files with the Khronos glTF validator and prints one JSON line per
-// file: {"file", "errors", "warnings", "infos", "hints", "messages": [first 20 issues]}.
+// file: {"file", "errors", "warnings", "infos", "hints", "messages": [the 20 most severe issues]}.
 // Exits 1 if any file has an error, 2 on a usage or read error.
 // Install once: `npm ci --prefix tools/gltf-validator`.
 'use strict';
@@ -26,7 +26,8 @@ async function main(files) {
         }),
     });
     const i = report.issues;
-    const messages = i.messages.slice(0, 20).map((m) => `${m.severity === 0 ? 'error' : m.severity === 1 ? 'warning' : m.severity === 2 ? 'info' : 'hint'} ${m.code} ${m.pointer || ''}: ${m.message}`);
+    // The most severe first, so that the 20 shown include every error and warning there is room for.
+    const messages = [...i.messages].sort((a, b) => a.severity - b.severity).slice(0, 20).map((m) => `${m.severity === 0 ? 'error' : m.severity === 1 ? 'warning' : m.severity === 2 ? 'info' : 'hint'} ${m.code} ${m.pointer || ''}: ${m.message}`);
     console.log(JSON.stringify({ file, errors: i.numErrors, warnings: i.numWarnings, infos: i.numInfos, hints: i.numHints, messages }));
     if (i.numErrors > 0) failed = true;
   }

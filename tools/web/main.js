@@ -1,22 +1,33 @@
-// Plays a Sylva glTF export in three.js: the tree's first level of detail, its baked clip
-// looping, an orbit camera. `?file=URL` picks the file (default tree.glb), `?lod=k` the
-// level shown, `?paused` stops the clock (the check script drives time through `probe`).
+// Plays a Sylva glTF export in three.js, one level of detail at a time, with an orbit
+// camera, in one of two modes:
+//   clip  — the baked clip loops on the skin (the default when the file has one);
+//   wind  — the engine-side wind: a static (or skinned) export animated in the vertex
+//           shader from the hierarchy packed in TEXCOORD_1…3 (wind.js): trunk bend, branch
+//           sway, leaf flutter, each element's phase. No skeleton: one draw per material.
+// `?file=URL` picks the file (default tree.glb), `?mode=clip|wind`, `?lod=k` the level
+// shown (the others come from `MSFT_lod` or `_LOD<k>` names and stay hidden), `?wind=k` the
+// wind shader's strength (default 1), `?paused` stops the clock and hides the status line
+// (the check script drives time through `probe`).
 //
-// `window.sylva` reports what was loaded and, through `probe(t)`, what the clip does at
+// `window.sylva` reports what was loaded and, through `probe(t)`, what the tree does at
 // time t: how far each leaf joint turns its leaves relative to the joint they hang on
-// (the leaves' own motion, see docs/GLTF.md), and the skinned positions of sample vertices.
+// (the leaves' own motion, see docs/GLTF.md), the skinned positions of sample vertices and
+// the draw calls of the frame.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { addWind } from './wind.js';
 
 const query = new URLSearchParams(location.search);
 const file = query.get('file') ?? 'tree.glb';
 const lod = Number(query.get('lod') ?? 0);
 const paused = query.has('paused');
 const status = document.getElementById('status');
+if (paused) status.style.display = 'none';
 
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1);
+renderer.info.autoReset = false;
 renderer.setSize(innerWidth, innerHeight);
 document.body.appendChild(renderer.domElement);
 const scene = new THREE.Scene();
@@ -38,8 +49,24 @@ function angleDeg(m) {
   return THREE.MathUtils.radToDeg(2 * Math.acos(Math.min(1, Math.abs(q.w))));
 }
 
-new GLTFLoader().load(file, (gltf) => {
+/** The coarser levels `MSFT_lod` names on the scene's nodes, loaded beside them (three.js
+ * loads only the scene's nodes). */
+async function loadLods(gltf) {
+  const json = gltf.parser.json;
+  for (const [i, node] of (json.nodes ?? []).entries()) {
+    const ids = node.extensions?.MSFT_lod?.ids ?? [];
+    if (!ids.length) continue;
+    const finest = gltf.parser.associations && [...gltf.scene.children].find((o) => gltf.parser.associations.get(o)?.nodes === i);
+    for (const id of ids) {
+      const level = await gltf.parser.getDependency('node', id);
+      (finest?.parent ?? gltf.scene).add(level);
+    }
+  }
+}
+
+new GLTFLoader().load(file, async (gltf) => {
   const root = gltf.scene;
+  await loadLods(gltf);
   // One level of detail: `<tree>_LOD<k>` nodes other than the chosen one are hidden.
   const lods = [];
   root.traverse((o) => { const m = /_LOD(\d+)$/.exec(o.name); if (m) lods.push([Number(m[1]), o]); });
@@ -57,12 +84,14 @@ new GLTFLoader().load(file, (gltf) => {
   const shown = lods.find(([k]) => k === lod)?.[1] ?? root;
   const skinned = [];
   shown.traverse((o) => { if (o.isSkinnedMesh) skinned.push(o); });
-  const leaves = skinned.find((m) => m.material.name === 'leaf') ?? null;
+  const leaves = skinned.find((m) => m.material.name.startsWith('leaf')) ?? null;
   const clip = gltf.animations[0] ?? null;
-  if (clip) {
+  const mode = query.get('mode') ?? (clip ? 'clip' : 'wind');
+  if (clip && mode === 'clip') {
     mixer = new THREE.AnimationMixer(root);
     mixer.clipAction(clip).play();
   }
+  const wind = mode === 'wind' ? addWind(shown, { height: box.max.y, strength: Number(query.get('wind') ?? 1) }) : null;
   // Leaf joints and the joints they hang on, as indices into the leaf mesh's skeleton.
   const pairs = [];
   if (leaves) {
@@ -79,12 +108,17 @@ new GLTFLoader().load(file, (gltf) => {
     visibleLods: lods.filter(([, o]) => o.visible).length,
     leafJoints: pairs.length,
     renderer: renderer.getContext().getParameter(renderer.getContext().VERSION),
-    /** Poses the clip at `t` seconds, renders, and reports the leaves' turn and samples. */
-    probe(t, samples = 64) {
+    mode,
+    windMeshes: wind?.meshes ?? 0,
+    /** Poses the clip (or the wind shader) at `t` seconds with wind strength `strength`,
+     * renders, and reports the leaves' turn, samples and the frame's draw calls. */
+    probe(t, samples = 64, strength = null) {
       if (mixer) mixer.setTime(t);
+      if (wind) wind.set(t, strength);
       scene.updateMatrixWorld(true);
+      renderer.info.reset();
       renderer.render(scene, camera);
-      const out = { t, leafTurnDeg: [], vertices: [] };
+      const out = { t, leafTurnDeg: [], vertices: [], drawCalls: renderer.info.render.calls };
       if (!leaves) return out;
       const s = leaves.skeleton;
       s.update();
@@ -101,6 +135,7 @@ new GLTFLoader().load(file, (gltf) => {
       }
       return out;
     },
+    tick: (t) => wind?.set(t),
     /** The canvas's pixels (RGBA rows), for comparing two renders. */
     pixels() {
       const gl = renderer.getContext();
@@ -109,7 +144,7 @@ new GLTFLoader().load(file, (gltf) => {
       return px;
     },
   };
-  status.textContent = `${file}: ${clip ? `clip “${clip.name}”, ${clip.duration.toFixed(2)} s` : 'static'}, ${pairs.length} leaf joints`;
+  status.textContent = `${file}: ${mode === 'clip' ? `clip “${clip.name}”, ${clip.duration.toFixed(2)} s` : 'wind shader'}, ${pairs.length} leaf joints, LOD${lod} of ${lods.length}`;
 }, undefined, (e) => {
   window.sylva = { ready: false, error: String(e?.message ?? e) };
   status.textContent = `could not load ${file}: ${window.sylva.error}`;
@@ -125,6 +160,8 @@ addEventListener('resize', () => {
 renderer.setAnimationLoop(() => {
   const dt = clock.getDelta();
   if (mixer && !paused) mixer.update(dt);
+  if (!paused) window.sylva.tick?.(clock.elapsedTime);
+  renderer.info.reset();
   controls.update();
   renderer.render(scene, camera);
 });

@@ -728,6 +728,8 @@ fn export_writes_a_looping_glb_and_reports_every_lod() {
             "--loop",
             "--blend",
             "0.25",
+            "--target",
+            "film",
             "--out",
             "palm.glb",
         ],
@@ -752,10 +754,37 @@ fn export_writes_a_looping_glb_and_reports_every_lod() {
     assert!(leaf > 0 && all == 309 + leaf, "{out}");
     let (ok, out, err) = sylva(
         dir.path(),
-        &["export", "--species", "palm", "--seconds", "0.5", "--no-leaf-joints", "--out", "rigid.glb"],
+        &[
+            "export",
+            "--species",
+            "palm",
+            "--seconds",
+            "0.5",
+            "--no-leaf-joints",
+            "--target",
+            "film",
+            "--out",
+            "rigid.glb",
+        ],
     );
     assert!(ok, "{out}\n{err}");
     assert_eq!(joints(&out), (309, 0), "{out}");
+    // The game target (the default): within its joint budget, leaf cards, reduced keys, the
+    // budget printed; `--lod-files` writes a file per level from one bake.
+    let (ok, out, err) = sylva(
+        dir.path(),
+        &["export", "--species", "palm", "--seconds", "2", "--loop", "--lod-files", "--out", "game.glb"],
+    );
+    assert!(ok, "{out}\n{err}");
+    assert_eq!(out.matches("baked in").count(), 1, "one bake for every file:\n{out}");
+    for k in 0..3 {
+        assert!(dir.path().join(format!("game_LOD{k}.glb")).exists(), "game_LOD{k}.glb:\n{out}");
+    }
+    assert!(!dir.path().join("game.glb").exists());
+    let (all, leaf) = joints(&out);
+    assert!(all <= 256 && leaf > 0, "{out}");
+    assert!(out.contains("cards") && out.contains("keys reduced within 0.05°"), "{out}");
+    assert!(out.contains("game budget: 256 joints per skin, 50000 / 16000 / 5000 triangles"), "{out}");
     // Static .gltf: one JSON file, no skin.
     let (ok, out, err) = sylva(dir.path(), &["export", "--species", "palm", "--static", "--out", "palm.gltf"]);
     assert!(ok, "{out}\n{err}");
@@ -771,7 +800,11 @@ fn export_rejects_bad_input_and_leaves_no_file() {
     let cases: &[(&[&str], &str)] = &[
         (&["--fps", "0"], "`fps` = 0"),
         (&["--seconds", "-2"], "`seconds` = -2"),
-        (&["--max-joints", "10"], "more than the limit of 10"),
+        (&["--target", "film", "--max-joints", "10"], "more than the limit of 10"),
+        (&["--max-joints", "0"], "`max_joints` = 0"),
+        (&["--key-tolerance", "-1"], "`key_tolerance` = -1"),
+        (&["--target", "mobile"], "invalid value 'mobile'"),
+        (&["--static", "--key-tolerance", "0.1"], "cannot be used with"),
         (&["--joints", "stem", "--max-joints", "10"], "joints (one per stem)"),
         (&["--lod", "8,3,8"], "four values"),
         (&["--lod", "2,3,8,1"], "`sides` = 2"),

@@ -9,7 +9,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use sylva_core::Tree;
-use sylva_core::export::gltf::tangents;
+use sylva_core::export::gltf::{GAME_BUDGET, tangents};
 use sylva_core::export::{
     BakeError, BakeParams, Clip, DEFAULT_LODS, GltfError, GltfOptions, JointMode, Lod, bake, build_gltf, write_gltf,
 };
@@ -39,7 +39,8 @@ fn animator(t: &Tree, method: &str) -> Box<dyn Animator> {
 }
 
 fn clip(t: &Tree, method: &str, seconds: f32, looped: bool) -> Clip {
-    let p = BakeParams { seconds, fps: 30.0, looped, blend: 0.5, preroll: 0.5, ..Default::default() };
+    // Every leaf's rotation kept, for the tests that compare leaves one by one.
+    let p = BakeParams { seconds, fps: 30.0, looped, blend: 0.5, preroll: 0.5, per_leaf: true, ..Default::default() };
     bake(animator(t, method).as_mut(), &gusty(), &p, &mut |_, _| {}).unwrap()
 }
 
@@ -91,12 +92,23 @@ fn every_kind_of_export_passes_the_khronos_validator_with_no_errors_or_warnings(
     let hsm = clip(&palm, "hsm", 0.5, false);
     write("palm_hsm_stems.glb", &palm, Some(&hsm), GltfOptions { joints: JointMode::Stem, ..Default::default() });
     write("palm_static.glb", &palm, None, GltfOptions::default());
+    // The game target and its options: quantised, float, with the custom attributes, one
+    // level per file (`--lod-files`), static.
+    let game = GltfOptions::game(&palm, &GAME_BUDGET);
+    write("palm_game_loop.glb", &palm, Some(&looped), game.clone());
+    write("palm_game_float.gltf", &palm, Some(&hsm), GltfOptions { quantize: false, ..game.clone() });
+    write("palm_game_custom.glb", &palm, Some(&hsm), GltfOptions { custom_attributes: true, ..game.clone() });
+    write("palm_game_lod1.glb", &palm, Some(&looped), GltfOptions { lods: vec![game.lods[1]], ..game.clone() });
+    write("palm_game_static.glb", &palm, None, game.clone());
+    let aspen = tree("quaking_aspen");
+    let aspen_clip = clip(&aspen, "skjermo", 0.5, false);
+    write("aspen_game.glb", &aspen, Some(&aspen_clip), GltfOptions::game(&aspen, &GAME_BUDGET));
     let zioma = clip(&willow, "zioma", 0.5, false);
     write(
         "lsystem_zioma.gltf",
         &willow,
         Some(&zioma),
-        GltfOptions { lods: vec![Lod { sides: 3, samples: 1, leaf_sides: 3, leaf_keep: 0.1 }], ..Default::default() },
+        GltfOptions { lods: vec![Lod::film(3, 1, 3, 0.1)], ..Default::default() },
     );
     let Some(script) = validator() else { return };
     let out = std::process::Command::new("node").arg(&script).args(&files).output().unwrap();
@@ -142,8 +154,7 @@ fn browser_check() -> Option<PathBuf> {
 fn a_three_js_page_in_headless_chromium_plays_the_clip_with_its_leaves_turning() {
     let t = tree("quaking_aspen");
     let c = clip(&t, "zioma", 1.0, false);
-    let opts =
-        GltfOptions { lods: vec![Lod { sides: 6, samples: 2, leaf_sides: 6, leaf_keep: 0.5 }], ..Default::default() };
+    let opts = GltfOptions { lods: vec![Lod::film(6, 2, 6, 0.5)], ..Default::default() };
     let doc = build_gltf(&t, Some(&c), &opts).unwrap();
     let mut bytes = Vec::new();
     doc.write_glb(&mut bytes).unwrap();
@@ -692,6 +703,86 @@ fn bad_inputs_are_refused_by_name_and_leave_no_file() {
 /// The leaf material's texture follows the tree's leaf shape (Weber–Penn `LeafShape`): read
 /// back from the file, its alpha is the outline `LeafShape::contains` draws, it clamps to its
 /// clear border, and the leaves' texture coordinates stay within a few hundredths of it.
+/// Runs `tools/web/check.js` on `bytes` with `args`; its JSON report.
+fn check_in_browser(script: &Path, bytes: &[u8], args: &[&str]) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("tree.glb");
+    std::fs::write(&path, bytes).unwrap();
+    let out = std::process::Command::new("node").arg(script).arg(&path).args(args).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let r: serde_json::Value = serde_json::from_str(stdout.trim())
+        .unwrap_or_else(|e| panic!("{e}: {stdout}\n{}", String::from_utf8_lossy(&out.stderr)));
+    assert!(out.status.success() && r["errors"].as_array().is_some_and(Vec::is_empty), "the page logged errors: {r}");
+    assert_eq!(r["ready"], true, "{r}");
+    r
+}
+
+#[test]
+fn the_page_s_wind_shader_sways_a_static_game_export_one_lod_drawn_and_matches_its_golden_image() {
+    let t = SpeciesSource::resolve("quaking_aspen").unwrap().generate(1, &Default::default(), None).unwrap();
+    let game = GltfOptions::game(&t, &GAME_BUDGET);
+    let static_glb = glb(&t, None, &game);
+    let c = clip(&t, "zioma", 1.0, false);
+    let skinned_glb = glb(&t, Some(&c), &game);
+    let Some(script) = browser_check() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let shot = dir.path().join("wind.png");
+    let shot_arg = shot.to_str().unwrap();
+    // The static export under the wind shader: no skeleton, one draw per material of LOD0
+    // (the coarser levels, loaded from `MSFT_lod`, stay hidden), pixels that change with
+    // time and none with the wind off.
+    let r = check_in_browser(&script, &static_glb, &["--size", "320", "--screenshot", shot_arg]);
+    assert_eq!(
+        (r["mode"].as_str(), r["lods"].as_u64(), r["visibleLods"].as_u64()),
+        (Some("wind"), Some(3), Some(1)),
+        "{r}"
+    );
+    assert_eq!(r["windMeshes"], 2, "bark and leaf cards take the wind shader: {r}");
+    for p in r["probes"].as_array().unwrap() {
+        assert_eq!(p["drawCalls"], 2, "one draw per material of one level: {r}");
+    }
+    let (moving, still) = (r["pixelsChanged"].as_f64().unwrap(), r["stillPixelsChanged"].as_f64().unwrap());
+    assert!(moving > 0.02, "the wind shader hardly moves the tree ({moving} of the pixels change)");
+    assert_eq!(still, 0.0, "with the wind off the picture must not change");
+    // The skinned game export plays its clip in the same page.
+    let r = check_in_browser(&script, &skinned_glb, &["--size", "320"]);
+    assert_eq!((r["mode"].as_str(), r["visibleLods"].as_u64()), (Some("clip"), Some(1)), "{r}");
+    assert!(r["probes"].as_array().unwrap().iter().all(|p| p["drawCalls"] == 2), "{r}");
+    let clip_moving = r["pixelsChanged"].as_f64().unwrap();
+    assert!(clip_moving > 0.02, "the clip hardly moves the tree ({clip_moving} of the pixels change)");
+    println!(
+        "aspen, game, 320 px: the wind shader changes {moving:.3} of the pixels over 2 s, the clip {clip_moving:.3} over 0.67 s"
+    );
+    // The wind shader's first frame against its golden image (SwiftShader renders the same
+    // pixels run to run; the tolerance allows for another Chromium's rasteriser).
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/web_wind_aspen.png");
+    let got = image::open(&shot).unwrap().to_rgb8();
+    if std::env::var("SYLVA_BLESS").is_ok_and(|v| v == "1") {
+        got.save(&golden).unwrap();
+        return;
+    }
+    let want = image::open(&golden)
+        .unwrap_or_else(|e| panic!("{}: {e} (SYLVA_BLESS=1 creates it)", golden.display()))
+        .to_rgb8();
+    assert_eq!(want.dimensions(), got.dimensions());
+    let diff: Vec<i32> =
+        got.pixels().zip(want.pixels()).map(|(a, b)| (0..3).map(|k| (a[k] as i32 - b[k] as i32).abs()).sum()).collect();
+    let mean = diff.iter().sum::<i32>() as f64 / (3 * diff.len()) as f64;
+    let share = diff.iter().filter(|&&d| d > 48).count() as f64 / diff.len() as f64;
+    println!(
+        "wind shader vs golden: mean difference {mean:.2} levels, {:.2} % of pixels differ by more than 48",
+        100.0 * share
+    );
+    if mean > 3.0 || share > 0.02 {
+        let actual = golden.with_file_name("web_wind_aspen.actual.png");
+        got.save(&actual).unwrap();
+        panic!(
+            "the wind shader's frame differs from its golden image (mean {mean:.2}, {share:.4} of pixels); wrote {}",
+            actual.display()
+        );
+    }
+}
+
 #[test]
 fn the_leaf_texture_follows_the_tree_s_leaf_shape() {
     use sylva_core::model::LeafShape;

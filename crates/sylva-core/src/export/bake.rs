@@ -1,7 +1,7 @@
 //! Baking: any animation method run on the CPU and sampled at a fixed frame rate into a
 //! [`Clip`] — per frame the pose seam's buffers (joint positions and accumulated
-//! rotations `D` per segment, a rotation per leaf), which skinning and the glTF exporter
-//! consume.
+//! rotations `D` per segment; per segment the sum of its leaves' rotations, and on request
+//! each leaf's), which skinning and the glTF exporter consume.
 //!
 //! # Looping clips
 //!
@@ -17,7 +17,7 @@
 //! seam. Blending is done on each segment's *local* transform (rotation and offset relative
 //! to its parent: slerp and lerp), and the pose is rebuilt root to tip, so the skeleton
 //! stays connected while blending; a leaf's rotation, already relative to its segment, is
-//! slerped. The last frame is a copy of the first (glTF clips play
+//! slerped, and a segment's sum of them lerped in one hemisphere. The last frame is a copy of the first (glTF clips play
 //! from the first key to the last).
 
 use crate::mesh::quat_slerp;
@@ -27,8 +27,10 @@ use crate::pose::SeamPose;
 use crate::wind::WindScene;
 use glam::{Quat, Vec3};
 
-/// Largest `frames × (segments + leaves)` a clip may hold (at most 32 bytes each: 512 MiB).
-pub const MAX_CLIP_VALUES: u64 = 16 << 20;
+/// Largest `frames × values per frame` a clip may hold (three per segment, one per leaf
+/// with [`BakeParams::per_leaf`]; 16 bytes each: 512 MiB, a 10 s loop of the largest
+/// shipped species at 30 fps with room to spare).
+pub const MAX_CLIP_VALUES: u64 = 32 << 20;
 
 /// How to bake (the method is the caller's: any [`Animator`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,11 +50,14 @@ pub struct BakeParams {
     /// Simulation steps per second of stateful methods. Default 120 Hz: every method is
     /// stable there, and it is a whole multiple of 24, 30 and 60 fps.
     pub sim_rate: f32,
+    /// Keep every leaf's rotation per frame ([`Clip::leaves`]); off, only each segment's sum
+    /// of them ([`Clip::leaf_sums`], all an export needs), so trees with 10⁵ leaves fit.
+    pub per_leaf: bool,
 }
 
 impl Default for BakeParams {
     fn default() -> Self {
-        Self { seconds: 10.0, fps: 30.0, looped: false, blend: 1.0, preroll: 2.0, sim_rate: 120.0 }
+        Self { seconds: 10.0, fps: 30.0, looped: false, blend: 1.0, preroll: 2.0, sim_rate: 120.0, per_leaf: false }
     }
 }
 
@@ -64,7 +69,7 @@ pub enum BakeError {
     Param { field: &'static str, value: String, expected: String },
     /// The clip would be too large.
     #[error(
-        "the clip would hold {frames} frames × {segments} segments and leaves; the limit is {limit} (shorten it, lower the fps or use a smaller tree)"
+        "the clip would hold {frames} frames × {segments} values (three per segment, one per leaf when kept); the limit is {limit} (shorten it, lower the fps or use a smaller tree)"
     )]
     TooLarge { frames: u64, segments: u64, limit: u64 },
     /// The method could not be built.
@@ -83,9 +88,14 @@ pub struct Clip {
     pub joints: Vec<Vec<[f32; 4]>>,
     /// Accumulated rotation `D` of every segment, per frame.
     pub acc: Vec<Vec<[f32; 4]>>,
-    /// Rotation of every leaf relative to its segment ([`SeamPose::leaf`]), per frame; an
-    /// empty frame has every leaf at rest.
+    /// Rotation of every leaf relative to its segment ([`SeamPose::leaf`]), per frame, with
+    /// [`BakeParams::per_leaf`]; an empty frame has every leaf at rest.
     pub leaves: Vec<Vec<[f32; 4]>>,
+    /// Per frame and segment, the sum of its leaves' rotations relative to it, each taken in
+    /// the identity's hemisphere (`(0, 0, 0, n)` for `n` leaves at rest; zero with none):
+    /// normalised, the least-squares single turn of the leaves, and summed over segments,
+    /// that of any group of them.
+    pub leaf_sums: Vec<Vec<[f32; 4]>>,
 }
 
 impl Clip {
@@ -163,7 +173,8 @@ pub fn bake(
 ) -> Result<Clip, BakeError> {
     let tree = anim.tree().clone();
     let tree = &*tree;
-    let (n, blend, steps) = params.check(tree.segments.len() + tree.leaves.len())?;
+    let values = 3 * tree.segments.len() + if params.per_leaf { tree.leaves.len() } else { 0 };
+    let (n, blend, steps) = params.check(values)?;
     anim.set_wind(std::sync::Arc::new(wind.packed()));
     let dt = 1.0 / (params.fps * steps as f32);
     // Preroll: whole frames of simulated time before frame 0.
@@ -173,19 +184,22 @@ pub fn bake(
     let mut joints = Vec::with_capacity(total);
     let mut acc = Vec::with_capacity(total);
     let mut leaves = Vec::with_capacity(total);
+    let mut sums = Vec::with_capacity(total);
     let mut seam = SeamPose::default();
     for k in 0..total {
         anim.advance(dt, if k == 0 { 0 } else { steps });
         anim.seam(&mut seam);
         joints.push(seam.joints.clone());
         acc.push(seam.acc.clone());
-        leaves.push(seam.leaf.clone());
+        sums.push(leaf_sums(tree, &seam.leaf));
+        leaves.push(if params.per_leaf { seam.leaf.clone() } else { Vec::new() });
         progress(k + 1, total);
     }
     if params.looped {
         let mut out_j = Vec::with_capacity(n + 1);
         let mut out_a = Vec::with_capacity(n + 1);
         let mut out_l = Vec::with_capacity(n + 1);
+        let mut out_s = Vec::with_capacity(n + 1);
         for k in 0..n {
             if k < blend {
                 let x = k as f32 / blend as f32;
@@ -194,20 +208,46 @@ pub fn bake(
                 out_j.push(j);
                 out_a.push(a);
                 out_l.push(blend_leaves(&leaves[k + n], &leaves[k], w));
+                out_s.push(blend_sums(&sums[k + n], &sums[k], w));
             } else {
                 out_j.push(std::mem::take(&mut joints[k]));
                 out_a.push(std::mem::take(&mut acc[k]));
                 out_l.push(std::mem::take(&mut leaves[k]));
+                out_s.push(std::mem::take(&mut sums[k]));
             }
         }
         out_j.push(out_j[0].clone());
         out_a.push(out_a[0].clone());
         out_l.push(out_l[0].clone());
+        out_s.push(out_s[0].clone());
         joints = out_j;
         acc = out_a;
         leaves = out_l;
+        sums = out_s;
     }
-    Ok(Clip { fps: params.fps, looped: params.looped, joints, acc, leaves })
+    Ok(Clip { fps: params.fps, looped: params.looped, joints, acc, leaves, leaf_sums: sums })
+}
+
+/// Per segment, the sum of its leaves' rotations `leaf` (by leaf index; a missing one at
+/// rest), each in the identity's hemisphere.
+pub fn leaf_sums(tree: &Tree, leaf: &[[f32; 4]]) -> Vec<[f32; 4]> {
+    let mut sum = vec![glam::Vec4::ZERO; tree.segments.len()];
+    for (i, &s) in tree.leaves.segment.iter().enumerate() {
+        let q = leaf.get(i).map_or(glam::Vec4::W, |q| glam::Vec4::from_array(*q));
+        sum[s as usize] += if q.w < 0.0 { -q } else { q };
+    }
+    sum.iter().map(|v| v.to_array()).collect()
+}
+
+/// Leaf sums `a` blended toward `b` by `w`, each pair lerped in one hemisphere.
+fn blend_sums(a: &[[f32; 4]], b: &[[f32; 4]], w: f32) -> Vec<[f32; 4]> {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| {
+            let (x, y) = (glam::Vec4::from_array(*x), glam::Vec4::from_array(*y));
+            x.lerp(if x.dot(y) < 0.0 { -y } else { y }, w).to_array()
+        })
+        .collect()
 }
 
 /// Each segment's transform relative to its parent's: rotation `D_p⁻¹ D` and offset

@@ -145,3 +145,54 @@ pub fn leaf_png(shape: LeafShape) -> Vec<u8> {
     }
     encode_png(&px, image::ExtendedColorType::Rgba8)
 }
+
+/// The leaves drawn on a leaf card: (attachment u, attachment v, angle from +v in rad).
+/// Four blades, each half the card's side, fanning from a twig up the middle: a card of
+/// side `s` carries the leaf area of four blades of side `s / 2`, one blade of side `s`.
+pub const CARD_LEAVES: [(f32, f32, f32); 4] = [(0.5, 0.36, 0.6), (0.5, 0.36, -0.6), (0.5, 0.1, 1.2), (0.5, 0.1, -1.2)];
+
+/// What a leaf card shows at (u, v): veins (0…1) and coverage (0…1) of the topmost blade,
+/// and the twig's coverage.
+fn card_sample(shape: LeafShape, u: f32, v: f32) -> (f32, f32, f32) {
+    let mut out = (0.0, 0.0, 0.0);
+    for &(au, av, angle) in &CARD_LEAVES {
+        let (dx, dy) = (u - au, v - av);
+        let (s, c) = angle.sin_cos();
+        // Blade coordinates: across (u) and along (v) a blade of side ½ turned by `angle`.
+        let (lu, lv) = ((dx * c - dy * s) * 2.0 + 0.5, (dx * s + dy * c) * 2.0);
+        if (0.0..=1.0).contains(&lu) && (0.0..=1.0).contains(&lv) {
+            let (light, edge) = leaf_veins(shape, lu, lv);
+            if edge > out.1 {
+                out = (light, edge, 0.0);
+            }
+        }
+    }
+    let twig = ((0.012 - (u - 0.5).abs()) * TEXTURE_SIZE as f32 + 0.5).clamp(0.0, 1.0) * f32::from(v < 0.4);
+    (out.0, out.1.max(twig), if out.1 < 0.5 { twig } else { 0.0 })
+}
+
+/// Leaf card: four blades of the shape on a twig ([`CARD_LEAVES`]), alpha 0 around them and
+/// on a clear border; RGBA PNG. Game exports carry several leaves per alpha-masked quad.
+pub fn leaf_card_png(shape: LeafShape) -> Vec<u8> {
+    let n = TEXTURE_SIZE;
+    let mut px = Vec::with_capacity((n * n * 4) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let (u, v) = ((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
+            let (light, cover, twig) = card_sample(shape, u, v);
+            let cover = if x == 0 || y == 0 || x == n - 1 || y == n - 1 { 0.0 } else { cover };
+            let shade = 0.85 + 0.15 * tiled_noise(u, v, 16, 71);
+            let leaf = [(0.16 + 0.20 * light) * shade, (0.38 + 0.25 * light) * shade, (0.08 + 0.12 * light) * shade];
+            let bark = [0.30, 0.24, 0.17];
+            let rgb: [f32; 3] = std::array::from_fn(|k| leaf[k] + (bark[k] - leaf[k]) * twig);
+            px.extend(rgb.iter().map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8));
+            px.push((cover * 255.0).round() as u8);
+        }
+    }
+    encode_png(&px, image::ExtendedColorType::Rgba8)
+}
+
+/// Leaf card normal map: the blades' midribs and veins raised.
+pub fn leaf_card_normal_png(shape: LeafShape) -> Vec<u8> {
+    normal_map(|u, v| card_sample(shape, u, v).0, 12.0)
+}

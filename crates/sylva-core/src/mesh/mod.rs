@@ -84,6 +84,10 @@ pub struct MeshParams {
     /// edge midpoints. Default 0.08 m: the trunk's and thick branches' long quads get the
     /// relief in between their rings, thin ones stay as they are. Infinity turns it off.
     pub subdivide_min_edge: f32,
+    /// Stems whose base radius is below this (m), and every stem on them, get no tube
+    /// (their leaves are still meshed). Default 0: every stem. Game assets leave the twigs
+    /// to their leaf cards.
+    pub min_stem_radius: f32,
 }
 
 impl Default for MeshParams {
@@ -96,8 +100,26 @@ impl Default for MeshParams {
             bark_depth: 0.06,
             displace_min_radius: 0.04,
             subdivide_min_edge: 0.08,
+            min_stem_radius: 0.0,
         }
     }
+}
+
+/// Leaf `index`'s draw in 0…1 for thinning ([`MeshLayout::thin_leaves`]).
+fn leaf_draw(key: u64, index: u64) -> f32 {
+    crate::rng::hash_unit(crate::rng::child_key(key, index)) as f32
+}
+
+/// Which stems get a tube: a stem at least `min_radius` thick at its base, on a stem that
+/// gets one (stems are in topological order: parents first).
+pub fn meshed_stems(tree: &Tree, min_radius: f32) -> Vec<bool> {
+    let st = &tree.stems;
+    let mut meshed = vec![false; st.len()];
+    for k in 0..st.len() {
+        let parent_meshed = st.parent[k] == NONE || meshed[st.parent[k] as usize];
+        meshed[k] = parent_meshed && tree.segments.radius_base[st.first_segment[k] as usize] >= min_radius;
+    }
+    meshed
 }
 
 /// Largest sides / samples accepted (bounds memory on user input).
@@ -250,9 +272,14 @@ impl MeshLayout {
         if params.subdivide_min_edge.is_nan() || params.subdivide_min_edge <= 0.0 {
             return bad("subdivide_min_edge", params.subdivide_min_edge.to_string(), "a positive length in m");
         }
+        if !(params.min_stem_radius.is_finite() && params.min_stem_radius >= 0.0) {
+            return bad("min_stem_radius", params.min_stem_radius.to_string(), "a length ≥ 0 in m");
+        }
         let s = &tree.segments;
         let st = &tree.stems;
-        let ring_count: u64 = st.segment_count.iter().map(|&n| n as u64 * params.samples as u64 + 1).sum();
+        let meshed = meshed_stems(tree, params.min_stem_radius);
+        let ring_count: u64 =
+            (0..st.len()).filter(|&k| meshed[k]).map(|k| st.segment_count[k] as u64 * params.samples as u64 + 1).sum();
         let tube_vertices = ring_count * (params.sides as u64 + 1);
         let leaf_vertices = if params.leaves { tree.leaves.len() as u64 * (params.leaf_sides as u64 + 1) } else { 0 };
         for v in [tube_vertices, leaf_vertices] {
@@ -264,7 +291,7 @@ impl MeshLayout {
         let mut tube_indices = Vec::new();
         let mut details = Vec::new();
         let sides = params.sides;
-        for k in 0..st.len() {
+        for k in (0..st.len()).filter(|&k| meshed[k]) {
             let first = st.first_segment[k] as usize;
             let n = st.segment_count[k] as usize;
             let base_radius = s.radius_base[first].max(1e-4);
@@ -484,7 +511,7 @@ impl MeshLayout {
         let mut index = 0u64;
         self.leaves.retain(|_| {
             index += 1;
-            (crate::rng::hash_unit(crate::rng::child_key(key, index)) as f32) < keep
+            leaf_draw(key, index) < keep
         });
         for l in &mut self.leaves {
             l.width *= grow;
@@ -498,6 +525,19 @@ impl MeshLayout {
             })
             .collect();
         Ok(())
+    }
+
+    /// The `leaf_keep` at which [`MeshLayout::thin_leaves`] keeps exactly `count` of
+    /// `leaves` leaves with `seed` (1 when `count ≥ leaves`; draws that tie keep fewer).
+    pub fn leaf_keep_for(count: usize, leaves: usize, seed: u64) -> f32 {
+        if count >= leaves {
+            return 1.0;
+        }
+        let key = crate::rng::mix64(seed ^ 0x1eaf);
+        let mut draws: Vec<f32> = (1..=leaves as u64).map(|i| leaf_draw(key, i)).collect();
+        draws.sort_by(f32::total_cmp);
+        // `draw < keep` holds for exactly the `count` smallest; a keep of 0 is refused.
+        draws[count].max(f32::MIN_POSITIVE)
     }
 
     /// Frame constants for the kernels.

@@ -3,6 +3,59 @@
 
 use super::*;
 
+/// How a primitive's vertex data is written.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Format {
+    /// With `JOINTS_0` and `WEIGHTS_0`.
+    pub(super) skinned: bool,
+    /// Compact: `KHR_mesh_quantization` normals and tangents (i8), texture coordinates in
+    /// 0…1 as u16, the axis as i16, joints u8 (≤ 256 joints) and weights u8, normalised.
+    pub(super) quantize: bool,
+    /// The custom float attributes `_PIVOT`, … as well.
+    pub(super) custom: bool,
+}
+
+/// Largest phase packed beside the depth in `TEXCOORD_1.x`, so that `floor` gives the depth.
+pub const PHASE_MAX: f32 = 0.999;
+
+/// Normalised i8 of `x` in −1…1 (glTF's `round(x × 127)`).
+pub(super) fn snorm8(x: f32) -> i8 {
+    (x.clamp(-1.0, 1.0) * 127.0).round() as i8
+}
+
+/// Normalised i16 of `x` in −1…1.
+pub(super) fn snorm16(x: f32) -> i16 {
+    (x.clamp(-1.0, 1.0) * 32767.0).round() as i16
+}
+
+/// Normalised u16 of `x` in 0…1.
+pub(super) fn unorm16(x: f32) -> u16 {
+    (x.clamp(0.0, 1.0) * 65535.0).round() as u16
+}
+
+/// Weights as normalised u8 summing to exactly 255 (the largest takes the rounding).
+pub(super) fn weights_u8(w: [f32; 4]) -> [u8; 4] {
+    let mut q = w.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as i32);
+    let big = (0..4).max_by(|&a, &b| w[a].total_cmp(&w[b]).then(b.cmp(&a))).unwrap_or(0);
+    q[big] += 255 - q.iter().sum::<i32>();
+    q.map(|x| x.clamp(0, 255) as u8)
+}
+
+/// Octahedral encoding of a unit vector in −1…1² (Cigolle et al. 2014): `x`, `z` of its
+/// projection onto the octahedron `|x|+|y|+|z| = 1`, the lower half folded out.
+pub fn octahedral(n: Vec3) -> [f32; 2] {
+    let n = n / (n.x.abs() + n.y.abs() + n.z.abs()).max(1e-20);
+    if n.y >= 0.0 { [n.x, n.z] } else { [(1.0 - n.z.abs()) * n.x.signum(), (1.0 - n.x.abs()) * n.z.signum()] }
+}
+
+/// The unit vector of an octahedral code ([`octahedral`]'s inverse).
+pub fn octahedral_decode(e: [f32; 2]) -> Vec3 {
+    let (x, z) = (e[0], e[1]);
+    let y = 1.0 - x.abs() - z.abs();
+    let (x, z) = if y < 0.0 { ((1.0 - z.abs()) * x.signum(), (1.0 - x.abs()) * z.signum()) } else { (x, z) };
+    Vec3::new(x, y, z).normalize()
+}
+
 pub(super) struct Builder {
     pub(super) root: json::Root,
     pub(super) bin: Vec<u8>,
@@ -14,6 +67,15 @@ impl Builder {
         bytes: &[u8],
         target: Option<json::buffer::Target>,
     ) -> json::Index<json::buffer::View> {
+        self.view_strided(bytes, target, None)
+    }
+
+    fn view_strided(
+        &mut self,
+        bytes: &[u8],
+        target: Option<json::buffer::Target>,
+        stride: Option<usize>,
+    ) -> json::Index<json::buffer::View> {
         while self.bin.len() % 4 != 0 {
             self.bin.push(0);
         }
@@ -23,7 +85,7 @@ impl Builder {
             buffer: json::Index::new(0),
             byte_length: USize64(bytes.len() as u64),
             byte_offset: Some(USize64(offset as u64)),
-            byte_stride: None,
+            byte_stride: stride.map(json::buffer::Stride),
             name: None,
             target: target.map(Valid),
             extensions: None,
@@ -55,6 +117,42 @@ impl Builder {
             max,
             name: None,
             normalized: false,
+            sparse: None,
+            extensions: None,
+            extras: Default::default(),
+        })
+    }
+
+    /// An integer vertex attribute of `T` (i8, u8, i16 or u16), `n` components per element,
+    /// each element padded to 4 bytes (glTF's vertex alignment).
+    pub(super) fn ints<T: bytemuck::Pod + Default>(
+        &mut self,
+        data: &[T],
+        ty: json::accessor::Type,
+        component: json::accessor::ComponentType,
+        normalized: bool,
+    ) -> json::Index<json::Accessor> {
+        let n = ty.multiplicity();
+        let size = std::mem::size_of::<T>() * n;
+        let stride = size.next_multiple_of(4);
+        let per = stride / std::mem::size_of::<T>();
+        let count = data.len() / n;
+        let mut padded = vec![T::default(); count * per];
+        for (out, x) in padded.chunks_exact_mut(per).zip(data.chunks_exact(n)) {
+            out[..n].copy_from_slice(x);
+        }
+        let target = Some(json::buffer::Target::ArrayBuffer);
+        let view = self.view_strided(bytemuck::cast_slice(&padded), target, (stride != size).then_some(stride));
+        self.root.push(json::Accessor {
+            buffer_view: Some(view),
+            byte_offset: None,
+            count: USize64(count as u64),
+            component_type: Valid(json::accessor::GenericComponentType(component)),
+            type_: Valid(ty),
+            min: None,
+            max: None,
+            name: None,
+            normalized,
             sparse: None,
             extensions: None,
             extras: Default::default(),
@@ -100,9 +198,10 @@ impl Builder {
         &mut self,
         g: &Geometry<'_>,
         rig: &Rig,
-        skinned: bool,
+        fmt: Format,
         material: json::Index<json::Material>,
     ) -> json::mesh::Primitive {
+        use json::accessor::ComponentType::{I8, I16, U8, U16, U32};
         use json::accessor::Type::{Scalar, Vec2, Vec3 as V3, Vec4};
         use json::mesh::Semantic;
         let v = g.vertices;
@@ -124,50 +223,90 @@ impl Builder {
             Some((lo.to_vec(), hi.to_vec())),
         );
         attributes.insert(Valid(Semantic::Positions), position);
-        let normals: Vec<f32> = v.iter().flat_map(|x| Vec3::from_array(x.normal).normalize().to_array()).collect();
-        attributes.insert(Valid(Semantic::Normals), self.floats(&normals, V3, true));
-        let tangents: Vec<f32> = g.tangents.iter().flatten().copied().collect();
-        attributes.insert(Valid(Semantic::Tangents), self.floats(&tangents, Vec4, true));
-        let uv: Vec<f32> = v.iter().flat_map(|x| [x.u, x.v]).collect();
-        attributes.insert(Valid(Semantic::TexCoords(0)), self.floats(&uv, Vec2, true));
-        if skinned {
+        let normals: Vec<Vec3> = v.iter().map(|x| Vec3::from_array(x.normal).normalize()).collect();
+        let (normal, tangent) = if fmt.quantize {
+            let n: Vec<i8> = normals.iter().flat_map(|n| n.to_array().map(snorm8)).collect();
+            let t: Vec<i8> = g.tangents.iter().flat_map(|t| t.map(snorm8)).collect();
+            (self.ints(&n, V3, I8, true), self.ints(&t, Vec4, I8, true))
+        } else {
+            let n: Vec<f32> = normals.iter().flat_map(|n| n.to_array()).collect();
+            let t: Vec<f32> = g.tangents.iter().flatten().copied().collect();
+            (self.floats(&n, V3, true), self.floats(&t, Vec4, true))
+        };
+        attributes.insert(Valid(Semantic::Normals), normal);
+        attributes.insert(Valid(Semantic::Tangents), tangent);
+        let in_unit = v.iter().all(|x| (0.0..=1.0).contains(&x.u) && (0.0..=1.0).contains(&x.v));
+        let uv = if fmt.quantize && in_unit {
+            let uv: Vec<u16> = v.iter().flat_map(|x| [unorm16(x.u), unorm16(x.v)]).collect();
+            self.ints(&uv, Vec2, U16, true)
+        } else {
+            let uv: Vec<f32> = v.iter().flat_map(|x| [x.u, x.v]).collect();
+            self.floats(&uv, Vec2, true)
+        };
+        attributes.insert(Valid(Semantic::TexCoords(0)), uv);
+        if fmt.skinned {
             let (joints, weights): (Vec<[u16; 4]>, Vec<[f32; 4]>) =
                 g.skin.iter().zip(v).map(|(s, x)| rig.bind(s, x.v)).unzip();
-            let j = self.accessor(
-                bytemuck::cast_slice(&joints),
-                joints.len(),
-                json::accessor::ComponentType::U16,
-                Vec4,
-                Some(json::buffer::Target::ArrayBuffer),
-                None,
-            );
+            let (j, w) = if fmt.quantize {
+                let weights: Vec<[u8; 4]> = weights.iter().map(|w| weights_u8(*w)).collect();
+                // A weight that rounds to zero leaves its joint unused: glTF wants it 0 too.
+                let joints: Vec<[u16; 4]> = joints
+                    .iter()
+                    .zip(&weights)
+                    .map(|(j, w)| std::array::from_fn(|k| if w[k] == 0 { 0 } else { j[k] }))
+                    .collect();
+                let j = if rig.joints() <= 256 {
+                    let j: Vec<u8> = joints.iter().flatten().map(|&j| j as u8).collect();
+                    self.ints(&j, Vec4, U8, false)
+                } else {
+                    self.ints(&joints.concat(), Vec4, U16, false)
+                };
+                (j, self.ints(&weights.concat(), Vec4, U8, true))
+            } else {
+                let w: Vec<f32> = weights.iter().flatten().copied().collect();
+                (self.ints(&joints.concat(), Vec4, U16, false), self.floats(&w, Vec4, true))
+            };
             attributes.insert(Valid(Semantic::Joints(0)), j);
-            let w: Vec<f32> = weights.iter().flatten().copied().collect();
-            attributes.insert(Valid(Semantic::Weights(0)), self.floats(&w, Vec4, true));
+            attributes.insert(Valid(Semantic::Weights(0)), w);
         }
+        // The hierarchy packed in standard channels (see "Hierarchy data" in the module
+        // documentation): every importer keeps texture coordinates.
         let e = &g.elements;
-        let pivot: Vec<f32> = e.iter().flat_map(|x| x.pivot.to_array()).collect();
-        attributes.insert(Valid(Semantic::Extras("PIVOT".into())), self.floats(&pivot, V3, true));
-        let axis: Vec<f32> = e.iter().flat_map(|x| x.axis.to_array()).collect();
-        attributes.insert(Valid(Semantic::Extras("BRANCH_AXIS".into())), self.floats(&axis, V3, true));
-        let depth: Vec<f32> = e.iter().map(|x| x.depth).collect();
-        attributes.insert(Valid(Semantic::Extras("HIERARCHY_DEPTH".into())), self.floats(&depth, Scalar, true));
-        let parent: Vec<f32> = e.iter().flat_map(|x| x.parent_pivot.to_array()).collect();
-        attributes.insert(Valid(Semantic::Extras("PARENT_PIVOT".into())), self.floats(&parent, V3, true));
-        let phase: Vec<f32> = e.iter().map(|x| x.phase).collect();
-        attributes.insert(Valid(Semantic::Extras("PHASE".into())), self.floats(&phase, Scalar, true));
-        if !g.flutter.is_empty() {
-            let flutter: Vec<f32> = g.flutter.iter().flatten().copied().collect();
-            attributes.insert(Valid(Semantic::Extras("LEAF_FLUTTER".into())), self.floats(&flutter, V3, true));
+        let t1: Vec<f32> = e.iter().flat_map(|x| [x.depth + x.phase.min(PHASE_MAX), x.pivot.y]).collect();
+        attributes.insert(Valid(Semantic::TexCoords(1)), self.floats(&t1, Vec2, true));
+        let t2: Vec<f32> = e.iter().flat_map(|x| [x.pivot.x, x.pivot.z]).collect();
+        attributes.insert(Valid(Semantic::TexCoords(2)), self.floats(&t2, Vec2, true));
+        let oct: Vec<[f32; 2]> = e.iter().map(|x| octahedral(x.axis)).collect();
+        let t3 = if fmt.quantize {
+            let t3: Vec<i16> = oct.iter().flat_map(|o| o.map(snorm16)).collect();
+            self.ints(&t3, Vec2, I16, true)
+        } else {
+            self.floats(&oct.concat(), Vec2, true)
+        };
+        attributes.insert(Valid(Semantic::TexCoords(3)), t3);
+        if fmt.custom {
+            let pivot: Vec<f32> = e.iter().flat_map(|x| x.pivot.to_array()).collect();
+            attributes.insert(Valid(Semantic::Extras("PIVOT".into())), self.floats(&pivot, V3, true));
+            let axis: Vec<f32> = e.iter().flat_map(|x| x.axis.to_array()).collect();
+            attributes.insert(Valid(Semantic::Extras("BRANCH_AXIS".into())), self.floats(&axis, V3, true));
+            let depth: Vec<f32> = e.iter().map(|x| x.depth).collect();
+            attributes.insert(Valid(Semantic::Extras("HIERARCHY_DEPTH".into())), self.floats(&depth, Scalar, true));
+            let parent: Vec<f32> = e.iter().flat_map(|x| x.parent_pivot.to_array()).collect();
+            attributes.insert(Valid(Semantic::Extras("PARENT_PIVOT".into())), self.floats(&parent, V3, true));
+            let phase: Vec<f32> = e.iter().map(|x| x.phase).collect();
+            attributes.insert(Valid(Semantic::Extras("PHASE".into())), self.floats(&phase, Scalar, true));
+            if !g.flutter.is_empty() {
+                let flutter: Vec<f32> = g.flutter.iter().flatten().copied().collect();
+                attributes.insert(Valid(Semantic::Extras("LEAF_FLUTTER".into())), self.floats(&flutter, V3, true));
+            }
         }
-        let indices = self.accessor(
-            bytemuck::cast_slice(g.indices),
-            g.indices.len(),
-            json::accessor::ComponentType::U32,
-            Scalar,
-            Some(json::buffer::Target::ElementArrayBuffer),
-            None,
-        );
+        let target = Some(json::buffer::Target::ElementArrayBuffer);
+        let indices = if v.len() <= u16::MAX as usize {
+            let short: Vec<u16> = g.indices.iter().map(|&i| i as u16).collect();
+            self.accessor(bytemuck::cast_slice(&short), short.len(), U16, Scalar, target, None)
+        } else {
+            self.accessor(bytemuck::cast_slice(g.indices), g.indices.len(), U32, Scalar, target, None)
+        };
         json::mesh::Primitive {
             attributes,
             indices: Some(indices),
@@ -189,6 +328,7 @@ impl Builder {
         rig: &Rig,
         nodes: &[json::Index<json::Node>],
         height: f32,
+        tolerance_deg: f32,
     ) -> Result<(Vec<json::animation::Sampler>, Vec<json::animation::Channel>), GltfError> {
         let frames = clip.frames();
         let joints = rig.driver.len();
@@ -228,7 +368,7 @@ impl Builder {
             }
             for (g, group) in rig.leaf_groups.iter().enumerate() {
                 let k = joints + g;
-                rot[k * frames + f] = rig::group_rotation(group, clip.leaves.get(f).map_or(&[], Vec::as_slice));
+                rot[k * frames + f] = rig::group_rotation(group, clip.leaf_sums.get(f).map_or(&[], Vec::as_slice));
                 off[k * frames + f] = group.pivot - s.start[rig.driver[group.parent as usize]];
             }
         }
@@ -252,7 +392,7 @@ impl Builder {
             let moves = r.iter().any(|q| q.xyz().length() > 1e-7);
             let o = &off[k * frames..(k + 1) * frames];
             let shifts = o.iter().any(|x| (*x - rest).length() > 1e-6 * height);
-            let mut channel = |b: &mut Builder, data: Vec<f32>, ty, path| {
+            let mut channel = |b: &mut Builder, input, data: Vec<f32>, ty, path| {
                 let output = b.floats(&data, ty, false);
                 samplers.push(json::animation::Sampler {
                     input,
@@ -274,14 +414,60 @@ impl Builder {
                 });
             };
             if moves {
-                let data = r.iter().flat_map(|q| q.to_array()).collect();
-                channel(self, data, json::accessor::Type::Vec4, json::animation::Property::Rotation);
+                let keep = reduce_keys(r, tolerance_deg.to_radians());
+                let (input, data) = if keep.len() == frames {
+                    (input, r.iter().flat_map(|q| q.to_array()).collect())
+                } else {
+                    let t: Vec<f32> = keep.iter().map(|&f| times[f]).collect();
+                    let bounds = Some((vec![0.0], vec![times[frames - 1]]));
+                    let scalar = json::accessor::Type::Scalar;
+                    let input = self.accessor(
+                        bytemuck::cast_slice(&t),
+                        t.len(),
+                        json::accessor::ComponentType::F32,
+                        scalar,
+                        None,
+                        bounds,
+                    );
+                    (input, keep.iter().flat_map(|&f| r[f].to_array()).collect())
+                };
+                channel(self, input, data, json::accessor::Type::Vec4, json::animation::Property::Rotation);
             }
             if shifts {
                 let data = o.iter().flat_map(|x| x.to_array()).collect();
-                channel(self, data, json::accessor::Type::Vec3, json::animation::Property::Translation);
+                channel(self, input, data, json::accessor::Type::Vec3, json::animation::Property::Translation);
             }
         }
         Ok((samplers, channels))
     }
+}
+
+/// The keys of `r` (one per frame, consecutive keys in one hemisphere) that keep every
+/// dropped key within `tolerance` (rad) of the slerp between the kept keys around it:
+/// greedily, each run as long as it stays within. The first and last keys are always kept;
+/// a tolerance of 0 keeps every key.
+pub fn reduce_keys(r: &[Quat], tolerance: f32) -> Vec<usize> {
+    let n = r.len();
+    if tolerance <= 0.0 || n <= 2 {
+        return (0..n).collect();
+    }
+    // |xyz| of the difference is sin(angle / 2): exact for small angles.
+    let limit = (0.5 * tolerance).sin();
+    let fits = |a: usize, b: usize| {
+        (a + 1..b).all(|k| {
+            let q = r[a].slerp(r[b], (k - a) as f32 / (b - a) as f32);
+            (r[k].conjugate() * q).xyz().length() <= limit
+        })
+    };
+    let mut keep = vec![0];
+    let mut a = 0;
+    while a + 1 < n {
+        let mut b = a + 1;
+        while b + 1 < n && fits(a, b + 1) {
+            b += 1;
+        }
+        keep.push(b);
+        a = b;
+    }
+    keep
 }

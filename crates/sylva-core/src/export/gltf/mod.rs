@@ -62,16 +62,20 @@
 //! leaf sides and fewer (larger) leaves ([`MeshLayout::thin_leaves`]).
 
 mod builder;
+mod cards;
 mod rig;
+mod target;
 
+pub use builder::{PHASE_MAX, octahedral, octahedral_decode, reduce_keys};
 pub use rig::tangents;
+pub use target::{Budget, CARD_TRIANGLES, GAME_BUDGET, KEY_TOLERANCE_DEG, Target, bark_triangles, game_lods};
 
 use super::bake::Clip;
 use super::textures;
 use crate::io::write_atomic;
 use crate::mesh::{MeshError, MeshLayout, MeshParams, RawSkin, RawVertex, SkinLayout};
 use crate::model::{NONE, RawLeaf, Tree};
-use builder::Builder;
+use builder::{Builder, Format};
 use glam::{Mat4, Quat, Vec3, Vec4};
 use gltf::json;
 use json::validation::{Checked::Valid, USize64};
@@ -87,6 +91,10 @@ pub enum JointMode {
     Segment,
     /// One joint per stem, driven by its base segment (see the module documentation).
     Stem,
+    /// At most this many joints, leaf joints included: the thickest segments head joints
+    /// (a stem's base first), every other segment rides with the joint of the segment it
+    /// hangs on — thin stems merge into their parents by size. Game engines' skin budget.
+    Budget(usize),
 }
 
 impl JointMode {
@@ -94,6 +102,7 @@ impl JointMode {
         match self {
             Self::Segment => "one per segment",
             Self::Stem => "one per stem",
+            Self::Budget(_) => "thickest segments within a budget",
         }
     }
 }
@@ -109,14 +118,25 @@ pub struct Lod {
     pub leaf_sides: u32,
     /// Fraction of the leaves kept (0…1], the rest scaled up to keep the leaf area.
     pub leaf_keep: f32,
+    /// Stems thinner than this at their base (m) get no bark (0: every stem); their leaves
+    /// stay, on the segments they hang on.
+    pub min_radius: f32,
+    /// Leaves as leaf cards: a square alpha-masked quad per kept leaf carrying four blades
+    /// on a twig (`textures::leaf_card_png`), two triangles, instead of a blade polygon.
+    pub cards: bool,
+    /// Subdivide the bark's long displaced bands (`MeshParams::subdivide_min_edge`).
+    pub subdivide: bool,
 }
 
-/// The default levels: full detail; about half; about a fifth.
-pub const DEFAULT_LODS: [Lod; 3] = [
-    Lod { sides: 8, samples: 3, leaf_sides: 8, leaf_keep: 1.0 },
-    Lod { sides: 6, samples: 2, leaf_sides: 6, leaf_keep: 0.5 },
-    Lod { sides: 4, samples: 1, leaf_sides: 4, leaf_keep: 0.25 },
-];
+impl Lod {
+    /// A film level: every stem, blade polygons, subdivided bark.
+    pub const fn film(sides: u32, samples: u32, leaf_sides: u32, leaf_keep: f32) -> Self {
+        Self { sides, samples, leaf_sides, leaf_keep, min_radius: 0.0, cards: false, subdivide: true }
+    }
+}
+
+/// The film levels: full detail; about half; about a fifth.
+pub const DEFAULT_LODS: [Lod; 3] = [Lod::film(8, 3, 8, 1.0), Lod::film(6, 2, 6, 0.5), Lod::film(4, 1, 4, 0.25)];
 
 /// Export options.
 #[derive(Debug, Clone, PartialEq)]
@@ -130,11 +150,32 @@ pub struct GltfOptions {
     /// A leaf joint for every joint that carries leaves, turning them in the clip (see the
     /// module documentation); off, leaves are rigid with their joint in the clip.
     pub leaf_joints: bool,
+    /// Compact vertex data (see "Compact data" in the module documentation).
+    pub quantize: bool,
+    /// The hierarchy also in the custom float attributes `_PIVOT`, `_BRANCH_AXIS`, …
+    /// (it is always packed in `TEXCOORD_1`…`TEXCOORD_3`).
+    pub custom_attributes: bool,
+    /// Rotation keys that linear interpolation of their neighbours reproduces within this
+    /// angle (degrees) are dropped; 0 keeps every key.
+    pub key_tolerance_deg: f32,
+    /// The level number of `lods[0]` in mesh and node names (`_LOD<k>`): a file holding one
+    /// coarser level of a set names it as the set does.
+    pub first_lod: usize,
 }
 
 impl Default for GltfOptions {
+    /// The film target.
     fn default() -> Self {
-        Self { joints: JointMode::Segment, max_joints: None, lods: DEFAULT_LODS.to_vec(), leaf_joints: true }
+        Self {
+            joints: JointMode::Segment,
+            max_joints: None,
+            lods: DEFAULT_LODS.to_vec(),
+            leaf_joints: true,
+            quantize: false,
+            custom_attributes: true,
+            key_tolerance_deg: 0.0,
+            first_lod: 0,
+        }
     }
 }
 
@@ -198,6 +239,8 @@ pub struct ExportReport {
     pub frames: usize,
     /// Animation channels.
     pub channels: usize,
+    /// Keys written over all channels (fewer than `frames × channels` when reduced).
+    pub keys: usize,
     /// Bytes of textures.
     pub texture_bytes: usize,
     /// Bytes of the skin and animation data.
@@ -255,9 +298,8 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         if let Some(bad) = c.joints.iter().chain(&c.acc).find(|f| f.len() != n) {
             return Err(GltfError::ClipMismatch { clip: bad.len(), tree: n, what: "segments" });
         }
-        let leaves = tree.leaves.len();
-        if let Some(bad) = c.leaves.iter().find(|f| !f.is_empty() && f.len() != leaves) {
-            return Err(GltfError::ClipMismatch { clip: bad.len(), tree: leaves, what: "leaf rotations" });
+        if let Some(bad) = c.leaf_sums.iter().find(|f| !f.is_empty() && f.len() != n) {
+            return Err(GltfError::ClipMismatch { clip: bad.len(), tree: n, what: "segments' leaf sums" });
         }
         if c.frames() < 2 {
             return Err(GltfError::Param {
@@ -266,6 +308,23 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
                 expected: "at least 2 frames".into(),
             });
         }
+    }
+    if !(opts.key_tolerance_deg.is_finite() && (0.0..=10.0).contains(&opts.key_tolerance_deg)) {
+        return Err(GltfError::Param {
+            field: "key_tolerance",
+            value: opts.key_tolerance_deg.to_string(),
+            expected: "0 to 10 degrees".into(),
+        });
+    }
+    if let JointMode::Budget(0) = opts.joints {
+        return Err(GltfError::Param { field: "max_joints", value: "0".into(), expected: "at least 1 joint".into() });
+    }
+    if let Some(bad) = opts.lods.iter().find(|l| !(l.min_radius.is_finite() && l.min_radius >= 0.0)) {
+        return Err(GltfError::Param {
+            field: "min_radius",
+            value: bad.min_radius.to_string(),
+            expected: "a stem radius ≥ 0 in m".into(),
+        });
     }
     let rig = Rig::new(tree, opts.joints, opts.leaf_joints && clip.is_some());
     let limit = opts.max_joints.unwrap_or(MAX_JOINTS).min(MAX_JOINTS);
@@ -278,7 +337,7 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
                 (JointMode::Segment, true) => " (try joints per stem)",
                 (JointMode::Segment, false) => " with leaf joints (try joints per stem, or no leaf joints)",
                 (JointMode::Stem, false) => " with leaf joints (try no leaf joints)",
-                (JointMode::Stem, true) => "",
+                (JointMode::Stem, true) | (JointMode::Budget(_), _) => "",
             },
         });
     }
@@ -315,9 +374,18 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
     let (sampler, leaf_sampler) =
         (sampler(json::texture::WrappingMode::Repeat), sampler(json::texture::WrappingMode::ClampToEdge));
     let bark_tex = b.texture("bark", &textures::bark_png(), sampler);
-    let leaf_tex = b.texture("leaf", &textures::leaf_png(tree.leaf_shape), leaf_sampler);
     let bark_normal = b.texture("bark_normal", &textures::bark_normal_png(), sampler);
-    let leaf_normal = b.texture("leaf_normal", &textures::leaf_normal_png(tree.leaf_shape), leaf_sampler);
+    let mut leaf_tex = None;
+    if opts.lods.iter().any(|l| !l.cards) {
+        let tex = b.texture("leaf", &textures::leaf_png(tree.leaf_shape), leaf_sampler);
+        leaf_tex = Some((tex, b.texture("leaf_normal", &textures::leaf_normal_png(tree.leaf_shape), leaf_sampler)));
+    }
+    let mut card_tex = None;
+    if opts.lods.iter().any(|l| l.cards) {
+        let tex = b.texture("leaf_card", &textures::leaf_card_png(tree.leaf_shape), leaf_sampler);
+        let normal = b.texture("leaf_card_normal", &textures::leaf_card_normal_png(tree.leaf_shape), leaf_sampler);
+        card_tex = Some((tex, normal));
+    }
     let texture_bytes = b.bin.len() - before;
     let material = |name: &str, tex, normal, roughness: f32, leaf: bool| json::Material {
         name: Some(name.into()),
@@ -345,7 +413,8 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         ..Default::default()
     };
     let bark_mat = b.root.push(material("bark", bark_tex, bark_normal, 0.9, false));
-    let leaf_mat = b.root.push(material("leaf", leaf_tex, leaf_normal, 0.55, true));
+    let leaf_mat = leaf_tex.map(|(t, n)| b.root.push(material("leaf", t, n, 0.55, true)));
+    let card_mat = card_tex.map(|(t, n)| b.root.push(material("leaf_card", t, n, 0.55, true)));
 
     // Skin: the armature and its joints.
     let height = tree.bounds().1.y - tree.bounds().0.y;
@@ -403,29 +472,44 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
     let hier = Hierarchy::new(tree);
     let flutter = rig::leaf_flutter(tree);
     let mut lods = Vec::new();
+    let mut lod_nodes = Vec::new();
     for (k, lod) in opts.lods.iter().enumerate() {
-        let params =
-            MeshParams { sides: lod.sides, samples: lod.samples, leaf_sides: lod.leaf_sides, ..MeshParams::default() };
+        let params = MeshParams {
+            sides: lod.sides,
+            samples: lod.samples,
+            leaf_sides: lod.leaf_sides,
+            min_stem_radius: lod.min_radius,
+            subdivide_min_edge: if lod.subdivide { MeshParams::default().subdivide_min_edge } else { f32::INFINITY },
+            ..MeshParams::default()
+        };
         let mut layout = MeshLayout::new(tree, params)?;
         layout.thin_leaves(lod.leaf_keep, tree.seed)?;
         let skinned = SkinLayout::new(&layout);
         let before = b.bin.len();
         let mut primitives = Vec::new();
+        let fmt = Format { skinned: clip.is_some(), quantize: opts.quantize, custom: opts.custom_attributes };
         let bark = Geometry::new(&skinned.tube_rest, &skinned.tube_skin, &layout.tube_indices, |_, s| {
             hier.bark(tree, s.bone0 as usize)
         });
-        primitives.push(b.primitive(&bark, &rig, clip.is_some(), bark_mat));
-        let leaf_stride = layout.params.leaf_sides as usize + 1;
+        primitives.push(b.primitive(&bark, &rig, fmt, bark_mat));
+        let cards = if lod.cards { cards::cards(&layout.leaves) } else { Default::default() };
+        let (vertices, leaf_skin, indices, leaf_stride, mat) = match (lod.cards, leaf_mat, card_mat) {
+            (true, _, Some(m)) => (&cards.0, &cards.1, &cards.2, cards::CARD_VERTICES, m),
+            (false, Some(m), _) => {
+                let stride = layout.params.leaf_sides as usize + 1;
+                (&skinned.leaf_rest, &skinned.leaf_skin, &layout.leaf_indices, stride, m)
+            }
+            _ => unreachable!("a material is made for every kind of leaf a level uses"),
+        };
         if !layout.leaves.is_empty() {
-            let mut leaves = Geometry::new(&skinned.leaf_rest, &skinned.leaf_skin, &layout.leaf_indices, |v, _| {
-                hier.leaf(tree, &layout.leaves[v / leaf_stride])
-            });
-            leaves.flutter = (0..skinned.leaf_rest.len())
+            let mut leaves =
+                Geometry::new(vertices, leaf_skin, indices, |v, _| hier.leaf(tree, &layout.leaves[v / leaf_stride]));
+            leaves.flutter = (0..vertices.len())
                 .map(|v| flutter.get(layout.leaves[v / leaf_stride].index as usize).copied().unwrap_or_default())
                 .collect();
-            primitives.push(b.primitive(&leaves, &rig, clip.is_some(), leaf_mat));
+            primitives.push(b.primitive(&leaves, &rig, fmt, mat));
         }
-        let name = format!("{}_LOD{k}", tree.name);
+        let name = format!("{}_LOD{}", tree.name, k + opts.first_lod);
         let mesh = b.root.push(json::Mesh {
             name: Some(name.clone()),
             primitives,
@@ -433,11 +517,11 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
             extensions: None,
             extras: Default::default(),
         });
-        scene_nodes.push(b.root.push(json::Node { name: Some(name), mesh: Some(mesh), skin, ..Default::default() }));
+        lod_nodes.push(b.root.push(json::Node { name: Some(name), mesh: Some(mesh), skin, ..Default::default() }));
         lods.push(LodReport {
             lod: *lod,
-            triangles: layout.triangle_count(),
-            vertices: layout.tube_vertex_count() + layout.leaf_vertex_count(),
+            triangles: (layout.tube_indices.len() + indices.len()) / 3,
+            vertices: layout.tube_vertex_count() + if lod.cards { vertices.len() } else { layout.leaf_vertex_count() },
             leaves: layout.leaves.len(),
             bytes: b.bin.len() - before,
         });
@@ -446,12 +530,35 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         }
     }
 
+    // Only the finest level is in the scene; `MSFT_lod` names the coarser ones, with the
+    // screen coverage below which each gives way to the next.
+    scene_nodes.push(lod_nodes[0]);
+    if lod_nodes.len() > 1 {
+        let ids: Vec<u32> = lod_nodes[1..].iter().map(|n| n.value() as u32).collect();
+        let node = &mut b.root.nodes[lod_nodes[0].value()];
+        let mut ext = json::extensions::scene::Node::default();
+        ext.others.insert("MSFT_lod".into(), serde_json::json!({ "ids": ids }));
+        node.extensions = Some(ext);
+        let coverage: Vec<f32> = (0..lod_nodes.len()).map(|k| lod_coverage(k + opts.first_lod)).collect();
+        node.extras = Some(
+            serde_json::value::to_raw_value(&serde_json::json!({ "MSFT_screencoverage": coverage }))
+                .map_err(|e| GltfError::Io { path: "extras".into(), message: e.to_string() })?,
+        );
+        b.root.extensions_used.push("MSFT_lod".into());
+    }
+    if opts.quantize {
+        b.root.extensions_used.push("KHR_mesh_quantization".into());
+        b.root.extensions_required.push("KHR_mesh_quantization".into());
+    }
+
     // Animation.
     let anim_mesh_bytes: usize = lods.iter().map(|l| l.bytes).sum();
     let mut channels = 0;
+    let mut keys = 0;
     if let Some(c) = clip {
-        let (samplers, chans) = b.animation(tree, c, &rig, &joint_nodes, height)?;
+        let (samplers, chans) = b.animation(tree, c, &rig, &joint_nodes, height, opts.key_tolerance_deg)?;
         channels = chans.len();
+        keys = samplers.iter().map(|s| b.root.accessors[s.input.value()].count.0 as usize).sum();
         b.root.push(json::Animation {
             name: Some(if c.looped { "wind_loop" } else { "wind" }.into()),
             channels: chans,
@@ -478,11 +585,18 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         leaf_joints: rig.leaf_groups.len(),
         frames: clip.map_or(0, |c| c.frames()),
         channels,
+        keys,
         texture_bytes,
         animation_bytes,
         bin_bytes: b.bin.len(),
     };
     Ok(GltfDocument { root: b.root, bin: b.bin, report })
+}
+
+/// Screen coverage (the share of the screen's height the tree's bounds fill) down to which
+/// level `k` is drawn: ½, then a third of the level before (`MSFT_screencoverage`).
+pub fn lod_coverage(k: usize) -> f32 {
+    0.5 / 3f32.powi(k as i32)
 }
 
 /// Builds and writes `path` atomically: `.glb` binary, `.gltf` JSON with data URIs.

@@ -29,6 +29,8 @@ pub(super) struct LeafGroup {
     pub(super) pivot: Vec3,
     /// The leaves (indices into the tree's leaves).
     pub(super) leaves: Vec<u32>,
+    /// The segments they hang on, each once.
+    pub(super) segments: Vec<u32>,
 }
 
 impl Rig {
@@ -43,6 +45,19 @@ impl Rig {
                 tree.stems.first_segment.iter().map(|&f| f as usize).collect::<Vec<_>>(),
                 tree.stems.parent.clone(),
             ),
+            JointMode::Budget(limit) => {
+                let order = thickest_first(tree);
+                // Fewest heads dropped so that heads + leaf joints fit the budget.
+                let mut k = order.len().min(limit.max(1));
+                loop {
+                    let heads = merged(tree, &order[..k]);
+                    let groups = if leaf_joints { leaf_bearing(tree, &heads.0) } else { 0 };
+                    if k + groups <= limit || k == 1 {
+                        break heads;
+                    }
+                    k -= ((k + groups - limit) / 2).max(1).min(k - 1);
+                }
+            }
         };
         let mut leaf_joint = vec![NONE; driver.len()];
         let mut leaf_groups: Vec<LeafGroup> = Vec::new();
@@ -52,13 +67,21 @@ impl Rig {
                 let j = joint_of_segment[l.segment[i] as usize];
                 if leaf_joint[j as usize] == NONE {
                     leaf_joint[j as usize] = leaf_groups.len() as u32;
-                    leaf_groups.push(LeafGroup { parent: j, pivot: Vec3::ZERO, leaves: Vec::new() });
+                    leaf_groups.push(LeafGroup {
+                        parent: j,
+                        pivot: Vec3::ZERO,
+                        leaves: Vec::new(),
+                        segments: Vec::new(),
+                    });
                 }
                 leaf_groups[leaf_joint[j as usize] as usize].leaves.push(i as u32);
             }
             for g in &mut leaf_groups {
                 let sum: Vec3 = g.leaves.iter().map(|&i| l.position[i as usize]).sum();
                 g.pivot = sum / g.leaves.len() as f32;
+                g.segments = g.leaves.iter().map(|&i| l.segment[i as usize]).collect();
+                g.segments.sort_unstable();
+                g.segments.dedup();
             }
         }
         Self { mode, joint_of_segment, driver, parent, leaf_groups, leaf_joint }
@@ -70,13 +93,18 @@ impl Rig {
     }
 
     pub(super) fn name(&self, j: usize) -> String {
-        let what = match self.mode {
-            JointMode::Segment => "segment",
-            JointMode::Stem => "stem",
+        // Joints per segment or budget are named by their head segment, per stem by the stem.
+        let (what, number) = match self.mode {
+            JointMode::Stem => ("stem", j),
+            _ => ("segment", self.driver[j.min(self.driver.len() - 1)]),
         };
         match j.checked_sub(self.driver.len()) {
-            None => format!("{what}_{j}"),
-            Some(g) => format!("leaves_{what}_{}", self.leaf_groups[g].parent),
+            None => format!("{what}_{number}"),
+            Some(g) => {
+                let p = self.leaf_groups[g].parent as usize;
+                let number = if self.mode == JointMode::Stem { p } else { self.driver[p] };
+                format!("leaves_{what}_{number}")
+            }
         }
     }
 
@@ -105,18 +133,55 @@ impl Rig {
     }
 }
 
+/// Segments that may head a joint, thickest base first (ties by index): a stem's first
+/// segment always may; a later one only after its stem's first (else it rides with it).
+fn thickest_first(tree: &Tree) -> Vec<usize> {
+    let s = &tree.segments;
+    let mut order: Vec<usize> = (0..s.len()).collect();
+    order.sort_by(|&a, &b| s.radius_base[b].total_cmp(&s.radius_base[a]).then(a.cmp(&b)));
+    let mut stem_in = vec![false; tree.stems.len()];
+    order.retain(|&i| {
+        let k = s.stem[i] as usize;
+        let first = tree.stems.first_segment[k] as usize == i;
+        stem_in[k] |= first;
+        first || stem_in[k]
+    });
+    order
+}
+
+/// The skeleton whose joints are headed by `heads`: every other segment rides with the
+/// joint of the segment it hangs on (the root always heads one).
+fn merged(tree: &Tree, heads: &[usize]) -> (Vec<u32>, Vec<usize>, Vec<u32>) {
+    let s = &tree.segments;
+    let mut head = vec![false; s.len()];
+    for &h in heads {
+        head[h] = true;
+    }
+    let (mut joint_of_segment, mut driver, mut parent) = (vec![0u32; s.len()], Vec::new(), Vec::new());
+    for i in 0..s.len() {
+        let p = s.parent[i];
+        if head[i] || p == NONE {
+            joint_of_segment[i] = driver.len() as u32;
+            driver.push(i);
+            parent.push(if p == NONE { NONE } else { joint_of_segment[p as usize] });
+        } else {
+            joint_of_segment[i] = joint_of_segment[p as usize];
+        }
+    }
+    (joint_of_segment, driver, parent)
+}
+
+/// How many joints carry leaves.
+fn leaf_bearing(tree: &Tree, joint_of_segment: &[u32]) -> usize {
+    let mut seen = std::collections::HashSet::new();
+    tree.leaves.segment.iter().filter(|&&s| seen.insert(joint_of_segment[s as usize])).count()
+}
+
 /// A leaf group's rotation at one frame: the normalised sum of its leaves' rotations (each
-/// in the hemisphere of the identity), relative to the segment they hang on; rest when the
-/// frame has none.
-pub(super) fn group_rotation(group: &LeafGroup, frame: &[[f32; 4]]) -> Quat {
-    if frame.is_empty() {
-        return Quat::IDENTITY;
-    }
-    let mut sum = Vec4::ZERO;
-    for &i in &group.leaves {
-        let q = frame.get(i as usize).map_or(Vec4::W, |q| Vec4::from_array(*q));
-        sum += if q.w < 0.0 { -q } else { q };
-    }
+/// in the hemisphere of the identity) relative to the segment they hang on, from the frame's
+/// per-segment sums ([`Clip::leaf_sums`]); rest when the frame has none.
+pub(super) fn group_rotation(group: &LeafGroup, sums: &[[f32; 4]]) -> Quat {
+    let sum: Vec4 = group.segments.iter().filter_map(|&s| sums.get(s as usize)).map(|q| Vec4::from_array(*q)).sum();
     sum.try_normalize().map_or(Quat::IDENTITY, Quat::from_vec4)
 }
 
@@ -214,38 +279,65 @@ impl<'a> Geometry<'a> {
     }
 }
 
-/// Per-vertex tangents (xyz unit, w the handedness) from the texture coordinates: each
-/// triangle's `∂P/∂u` and `∂P/∂v` summed at its corners, `∂P/∂u` made orthogonal to the
-/// normal; a vertex without a usable gradient gets any tangent orthogonal to its normal.
+/// Per-vertex tangents (xyz unit, w the handedness) by MikkTSpace (`bevy_mikktspace`, the
+/// algorithm Blender, Unity, Unreal and glTF's sample viewer bake normal maps with), so a
+/// normal map reads the same in every engine. A vertex shared by faces keeps the last face's
+/// tangent (MikkTSpace would split it only where the faces disagree); one MikkTSpace leaves
+/// without a value gets any tangent orthogonal to its normal.
 pub fn tangents(vertices: &[RawVertex], indices: &[u32]) -> Vec<[f32; 4]> {
-    let mut du = vec![Vec3::ZERO; vertices.len()];
-    let mut dv = vec![Vec3::ZERO; vertices.len()];
-    for t in indices.chunks_exact(3) {
-        let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
-        let p = |i: usize| Vec3::from_array(vertices[i].position);
-        let (e1, e2) = (p(b) - p(a), p(c) - p(a));
-        let (u1, v1) = (vertices[b].u - vertices[a].u, vertices[b].v - vertices[a].v);
-        let (u2, v2) = (vertices[c].u - vertices[a].u, vertices[c].v - vertices[a].v);
-        let det = u1 * v2 - u2 * v1;
-        if det.abs() < 1e-12 {
-            continue;
-        }
-        let r = 1.0 / det;
-        let s = (e1 * v2 - e2 * v1) * r;
-        let w = (e2 * u1 - e1 * u2) * r;
-        for i in [a, b, c] {
-            du[i] += s;
-            dv[i] += w;
+    struct Mesh<'a> {
+        vertices: &'a [RawVertex],
+        indices: &'a [u32],
+        out: Vec<Option<[f32; 4]>>,
+    }
+    impl Mesh<'_> {
+        fn at(&self, face: usize, vert: usize) -> &RawVertex {
+            &self.vertices[self.indices[face * 3 + vert] as usize]
         }
     }
+    impl bevy_mikktspace::Geometry for Mesh<'_> {
+        fn num_faces(&self) -> usize {
+            self.indices.len() / 3
+        }
+        fn num_vertices_of_face(&self, _: usize) -> usize {
+            3
+        }
+        fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.at(face, vert).position
+        }
+        fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+            Vec3::from_array(self.at(face, vert).normal).normalize_or_zero().to_array()
+        }
+        fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+            let v = self.at(face, vert);
+            [v.u, v.v]
+        }
+        fn set_tangent(&mut self, t: Option<bevy_mikktspace::TangentSpace>, face: usize, vert: usize) {
+            if let Some(t) = t {
+                self.out[self.indices[face * 3 + vert] as usize] = Some(t.tangent_encoded());
+            }
+        }
+    }
+    let mut mesh = Mesh { vertices, indices, out: vec![None; vertices.len()] };
+    // An error only means no face could be processed: every vertex takes the fallback.
+    let _ = bevy_mikktspace::generate_tangents(&mut mesh);
     vertices
         .iter()
-        .enumerate()
-        .map(|(i, v)| {
-            let n = Vec3::from_array(v.normal).normalize();
-            let t = (du[i] - n * n.dot(du[i])).try_normalize().unwrap_or_else(|| n.any_orthonormal_vector());
-            let w = if n.cross(t).dot(dv[i]) < 0.0 { -1.0 } else { 1.0 };
-            [t.x, t.y, t.z, w]
+        .zip(mesh.out)
+        .map(|(v, t)| {
+            let n = Vec3::from_array(v.normal).normalize_or(Vec3::Y);
+            match t {
+                Some([x, y, z, w]) => match Vec3::new(x, y, z).try_normalize() {
+                    Some(t) => [t.x, t.y, t.z, if w < 0.0 { -1.0 } else { 1.0 }],
+                    None => fallback(n),
+                },
+                None => fallback(n),
+            }
         })
         .collect()
+}
+
+fn fallback(n: Vec3) -> [f32; 4] {
+    let t = n.any_orthonormal_vector();
+    [t.x, t.y, t.z, 1.0]
 }
