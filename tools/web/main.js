@@ -16,6 +16,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { addWind } from './wind.js';
 
 const query = new URLSearchParams(location.search);
@@ -64,7 +65,7 @@ async function loadLods(gltf) {
   }
 }
 
-new GLTFLoader().load(file, async (gltf) => {
+new GLTFLoader().setMeshoptDecoder(MeshoptDecoder).load(file, async (gltf) => {
   const root = gltf.scene;
   await loadLods(gltf);
   // One level of detail: `<tree>_LOD<k>` nodes other than the chosen one are hidden.

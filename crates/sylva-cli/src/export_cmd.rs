@@ -90,6 +90,10 @@ pub struct ExportArgs {
     /// One file per level of detail (`<out>_LOD0.glb`, `_LOD1`, …) instead of one file.
     #[arg(long)]
     pub lod_files: bool,
+    /// Compress vertex, index and animation data with `EXT_meshopt_compression` (required
+    /// by the file: the loader needs a meshopt decoder, as three.js's `setMeshoptDecoder`).
+    #[arg(long)]
+    pub meshopt: bool,
     /// No leaf joints: leaves stay rigid with their branch in the clip (their flutter is
     /// still in the `_LEAF_FLUTTER` attribute, for an engine shader).
     #[arg(long, conflicts_with = "static_only")]
@@ -200,6 +204,7 @@ fn options(a: &ExportArgs, tree: &sylva_core::model::Tree) -> GltfOptions {
     opts.leaf_joints = !a.no_leaf_joints;
     opts.custom_attributes |= a.custom_attributes;
     opts.quantize &= !a.no_quantize;
+    opts.meshopt = a.meshopt;
     if let Some(t) = a.key_tolerance {
         opts.key_tolerance_deg = t;
     }

@@ -785,6 +785,13 @@ fn export_writes_a_looping_glb_and_reports_every_lod() {
     assert!(all <= 256 && leaf > 0, "{out}");
     assert!(out.contains("cards") && out.contains("keys reduced within 0.05°"), "{out}");
     assert!(out.contains("game budget: 256 joints per skin, 50000 / 16000 / 5000 triangles"), "{out}");
+    // `--meshopt`: the same file, smaller, requiring the extension.
+    let (ok, out, err) = sylva(dir.path(), &["export", "--species", "palm", "--static", "--meshopt", "--out", "m.glb"]);
+    assert!(ok, "{out}\n{err}");
+    let (ok, _, _) = sylva(dir.path(), &["export", "--species", "palm", "--static", "--out", "p.glb"]);
+    assert!(ok);
+    let (m, p) = (std::fs::read(dir.path().join("m.glb")).unwrap(), std::fs::read(dir.path().join("p.glb")).unwrap());
+    assert!(m.len() < p.len() && m.windows(23).any(|w| w == b"EXT_meshopt_compression"), "{} vs {}", m.len(), p.len());
     // Static .gltf: one JSON file, no skin.
     let (ok, out, err) = sylva(dir.path(), &["export", "--species", "palm", "--static", "--out", "palm.gltf"]);
     assert!(ok, "{out}\n{err}");

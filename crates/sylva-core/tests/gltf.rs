@@ -100,6 +100,8 @@ fn every_kind_of_export_passes_the_khronos_validator_with_no_errors_or_warnings(
     write("palm_game_custom.glb", &palm, Some(&hsm), GltfOptions { custom_attributes: true, ..game.clone() });
     write("palm_game_lod1.glb", &palm, Some(&looped), GltfOptions { lods: vec![game.lods[1]], ..game.clone() });
     write("palm_game_static.glb", &palm, None, game.clone());
+    write("palm_game_meshopt.glb", &palm, Some(&looped), GltfOptions { meshopt: true, ..game.clone() });
+    write("palm_game_meshopt.gltf", &palm, None, GltfOptions { meshopt: true, ..game.clone() });
     let aspen = tree("quaking_aspen");
     let aspen_clip = clip(&aspen, "skjermo", 0.5, false);
     write("aspen_game.glb", &aspen, Some(&aspen_clip), GltfOptions::game(&aspen, &GAME_BUDGET));
@@ -750,6 +752,12 @@ fn the_page_s_wind_shader_sways_a_static_game_export_one_lod_drawn_and_matches_i
     assert!(r["probes"].as_array().unwrap().iter().all(|p| p["drawCalls"] == 2), "{r}");
     let clip_moving = r["pixelsChanged"].as_f64().unwrap();
     assert!(clip_moving > 0.02, "the clip hardly moves the tree ({clip_moving} of the pixels change)");
+    // The same, compressed with `EXT_meshopt_compression`: three.js decodes it and plays it alike.
+    let packed = glb(&t, Some(&c), &GltfOptions { meshopt: true, ..game.clone() });
+    let m = check_in_browser(&script, &packed, &["--size", "320"]);
+    assert_eq!((m["visibleLods"].as_u64(), m["leafJoints"].as_u64()), (Some(1), r["leafJoints"].as_u64()), "{m}");
+    assert!(m["probes"].as_array().unwrap().iter().all(|p| p["drawCalls"] == 2), "{m}");
+    assert!((m["pixelsChanged"].as_f64().unwrap() - clip_moving).abs() < 1e-3, "meshopt changed the pictures: {m}");
     println!(
         "aspen, game, 320 px: the wind shader changes {moving:.3} of the pixels over 2 s, the clip {clip_moving:.3} over 0.67 s"
     );

@@ -419,3 +419,85 @@ fn mikktspace_tangents_follow_u_across_a_card_and_around_a_stem() {
     let worst = tg[..n].iter().map(|g| Vec3::from_slice(&g[..3]).dot(axis).abs()).fold(0.0, f32::max);
     assert!(worst < 0.2, "a trunk tangent leans {worst} along the trunk");
 }
+
+/// `encoded` (a meshopt vertex stream of `count` elements of `stride` bytes) decoded.
+fn decode_attributes(encoded: &[u8], count: usize, stride: usize) -> Vec<u8> {
+    macro_rules! words {
+        ($k:literal) => {{
+            let v: Vec<[u32; $k]> = ::meshopt::decode_vertex_buffer(encoded, count).unwrap();
+            v.iter().flat_map(|e| e.iter().flat_map(|w| w.to_le_bytes())).collect()
+        }};
+    }
+    match stride {
+        4 => words!(1),
+        8 => words!(2),
+        12 => words!(3),
+        16 => words!(4),
+        20 => words!(5),
+        24 => words!(6),
+        28 => words!(7),
+        32 => words!(8),
+        64 => words!(16),
+        s => panic!("stride {s}"),
+    }
+}
+
+#[test]
+fn meshopt_compressed_views_decode_to_the_uncompressed_bytes() {
+    let t = tree("palm");
+    let c = clip(&t, 2.0, true);
+    let game = GltfOptions::game(&t, &GAME_BUDGET);
+    let plain = glb(&t, Some(&c), &game);
+    let packed = glb(&t, Some(&c), &GltfOptions { meshopt: true, ..game });
+    let json = |b: &[u8]| -> (serde_json::Value, Vec<u8>) {
+        let g = gltf::binary::Glb::from_slice(b).unwrap();
+        (serde_json::from_slice(&g.json).unwrap(), g.bin.unwrap().into_owned())
+    };
+    let ((pj, pb), (mj, mb)) = (json(&plain), json(&packed));
+    assert!(mj["extensionsRequired"].as_array().unwrap().iter().any(|e| e == "EXT_meshopt_compression"));
+    assert_eq!(mj["buffers"][1]["extensions"]["EXT_meshopt_compression"]["fallback"], true);
+    assert!(mj["buffers"][1].get("uri").is_none(), "the fallback buffer holds no data");
+    let views = pj["bufferViews"].as_array().unwrap();
+    assert_eq!(views.len(), mj["bufferViews"].as_array().unwrap().len());
+    let (mut compressed, mut same) = (0, 0);
+    for (i, v) in views.iter().enumerate() {
+        let at = |v: &serde_json::Value, k: &str| v[k].as_u64().unwrap_or(0) as usize;
+        let want = &pb[at(v, "byteOffset")..at(v, "byteOffset") + at(v, "byteLength")];
+        let m = &mj["bufferViews"][i];
+        let Some(e) = m["extensions"].get("EXT_meshopt_compression") else {
+            // Images stay as they are, in the file's buffer.
+            assert_eq!(at(m, "buffer"), 0);
+            assert_eq!(&mb[at(m, "byteOffset")..at(m, "byteOffset") + at(m, "byteLength")], want, "view {i}");
+            same += 1;
+            continue;
+        };
+        assert_eq!((at(m, "buffer"), at(m, "byteLength")), (1, want.len()), "view {i} stands in the fallback");
+        let data = &mb[at(e, "byteOffset")..at(e, "byteOffset") + at(e, "byteLength")];
+        let (count, stride) = (at(e, "count"), at(e, "byteStride"));
+        let got: Vec<u8> = match e["mode"].as_str().unwrap() {
+            "ATTRIBUTES" => {
+                assert_eq!(::meshopt::decode_vertex_version(data), Some(0), "EXT_ allows vertex codec 0 only");
+                decode_attributes(data, count, stride)
+            }
+            "TRIANGLES" if stride == 2 => ::meshopt::decode_index_buffer::<u16>(data, count)
+                .unwrap()
+                .iter()
+                .flat_map(|i| i.to_le_bytes())
+                .collect(),
+            "TRIANGLES" => ::meshopt::decode_index_buffer::<u32>(data, count)
+                .unwrap()
+                .iter()
+                .flat_map(|i| i.to_le_bytes())
+                .collect(),
+            m => panic!("mode {m}"),
+        };
+        assert_eq!(got, want, "view {i} decodes to its uncompressed bytes");
+        compressed += 1;
+    }
+    println!(
+        "palm, game, 2 s loop: {compressed} views compressed, {same} images kept; {:.2} MiB → {:.2} MiB",
+        plain.len() as f64 / (1 << 20) as f64,
+        packed.len() as f64 / (1 << 20) as f64
+    );
+    assert!(compressed > 10 && packed.len() < plain.len() * 3 / 4, "{} → {} bytes", plain.len(), packed.len());
+}

@@ -125,25 +125,36 @@ pub fn bark_png() -> Vec<u8> {
     encode_png(&px, image::ExtendedColorType::Rgb8)
 }
 
-/// Leaf: green blade with a lighter midrib and veins, alpha 255 inside the outline and 0
-/// outside the shape's outline (a one-pixel soft edge); RGBA PNG.
-pub fn leaf_png(shape: LeafShape) -> Vec<u8> {
+/// An RGBA leaf texture: `blade(u, v)` gives the veins' lightness (0…1), the coverage (alpha,
+/// 0…1) and how much of the pixel is twig (0…1); leaf green shaded by noise, twig brown, and
+/// a clear one-pixel border (leaf polygons and cards reach the square's edge, and a sampler
+/// that clamps to the edge shows nothing there).
+fn leaf_rgba(blade: impl Fn(f32, f32) -> (f32, f32, f32)) -> Vec<u8> {
     let n = TEXTURE_SIZE;
     let mut px = Vec::with_capacity((n * n * 4) as usize);
     for y in 0..n {
         for x in 0..n {
             let (u, v) = ((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
-            let (light, edge) = leaf_veins(shape, u, v);
-            // A clear border: the leaf polygon reaches just past the square, and a sampler
-            // that clamps to the edge shows nothing there.
-            let edge = if x == 0 || y == 0 || x == n - 1 || y == n - 1 { 0.0 } else { edge };
+            let (light, cover, twig) = blade(u, v);
+            let cover = if x == 0 || y == 0 || x == n - 1 || y == n - 1 { 0.0 } else { cover };
             let shade = 0.85 + 0.15 * tiled_noise(u, v, 16, 71);
-            let rgb = [(0.16 + 0.20 * light) * shade, (0.38 + 0.25 * light) * shade, (0.08 + 0.12 * light) * shade];
+            let leaf = [(0.16 + 0.20 * light) * shade, (0.38 + 0.25 * light) * shade, (0.08 + 0.12 * light) * shade];
+            let bark = [0.30, 0.24, 0.17];
+            let rgb: [f32; 3] = std::array::from_fn(|k| leaf[k] + (bark[k] - leaf[k]) * twig);
             px.extend(rgb.iter().map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8));
-            px.push((edge * 255.0).round() as u8);
+            px.push((cover * 255.0).round() as u8);
         }
     }
     encode_png(&px, image::ExtendedColorType::Rgba8)
+}
+
+/// Leaf: green blade with a lighter midrib and veins, alpha 255 inside the outline and 0
+/// outside the shape's outline (a one-pixel soft edge); RGBA PNG.
+pub fn leaf_png(shape: LeafShape) -> Vec<u8> {
+    leaf_rgba(|u, v| {
+        let (light, edge) = leaf_veins(shape, u, v);
+        (light, edge, 0.0)
+    })
 }
 
 /// The leaves drawn on a leaf card: (attachment u, attachment v, angle from +v in rad).
@@ -174,22 +185,7 @@ fn card_sample(shape: LeafShape, u: f32, v: f32) -> (f32, f32, f32) {
 /// Leaf card: four blades of the shape on a twig ([`CARD_LEAVES`]), alpha 0 around them and
 /// on a clear border; RGBA PNG. Game exports carry several leaves per alpha-masked quad.
 pub fn leaf_card_png(shape: LeafShape) -> Vec<u8> {
-    let n = TEXTURE_SIZE;
-    let mut px = Vec::with_capacity((n * n * 4) as usize);
-    for y in 0..n {
-        for x in 0..n {
-            let (u, v) = ((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
-            let (light, cover, twig) = card_sample(shape, u, v);
-            let cover = if x == 0 || y == 0 || x == n - 1 || y == n - 1 { 0.0 } else { cover };
-            let shade = 0.85 + 0.15 * tiled_noise(u, v, 16, 71);
-            let leaf = [(0.16 + 0.20 * light) * shade, (0.38 + 0.25 * light) * shade, (0.08 + 0.12 * light) * shade];
-            let bark = [0.30, 0.24, 0.17];
-            let rgb: [f32; 3] = std::array::from_fn(|k| leaf[k] + (bark[k] - leaf[k]) * twig);
-            px.extend(rgb.iter().map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8));
-            px.push((cover * 255.0).round() as u8);
-        }
-    }
-    encode_png(&px, image::ExtendedColorType::Rgba8)
+    leaf_rgba(|u, v| card_sample(shape, u, v))
 }
 
 /// Leaf card normal map: the blades' midribs and veins raised.

@@ -107,20 +107,7 @@ impl Builder {
             Some((lo, hi)) => (Some(json::Value::from(lo)), Some(json::Value::from(hi))),
             None => (None, None),
         };
-        self.root.push(json::Accessor {
-            buffer_view: Some(view),
-            byte_offset: None,
-            count: USize64(count as u64),
-            component_type: Valid(json::accessor::GenericComponentType(component)),
-            type_: Valid(ty),
-            min,
-            max,
-            name: None,
-            normalized: false,
-            sparse: None,
-            extensions: None,
-            extras: Default::default(),
-        })
+        self.push_accessor(view, count, component, ty, (min, max), false)
     }
 
     /// An integer vertex attribute of `T` (i8, u8, i16 or u16), `n` components per element,
@@ -143,14 +130,26 @@ impl Builder {
         }
         let target = Some(json::buffer::Target::ArrayBuffer);
         let view = self.view_strided(bytemuck::cast_slice(&padded), target, (stride != size).then_some(stride));
+        self.push_accessor(view, count, component, ty, (None, None), normalized)
+    }
+
+    fn push_accessor(
+        &mut self,
+        view: json::Index<json::buffer::View>,
+        count: usize,
+        component: json::accessor::ComponentType,
+        ty: json::accessor::Type,
+        (min, max): (Option<json::Value>, Option<json::Value>),
+        normalized: bool,
+    ) -> json::Index<json::Accessor> {
         self.root.push(json::Accessor {
             buffer_view: Some(view),
             byte_offset: None,
             count: USize64(count as u64),
             component_type: Valid(json::accessor::GenericComponentType(component)),
             type_: Valid(ty),
-            min: None,
-            max: None,
+            min,
+            max,
             name: None,
             normalized,
             sparse: None,

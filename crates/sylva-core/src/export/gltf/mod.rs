@@ -63,6 +63,7 @@
 
 mod builder;
 mod cards;
+mod meshopt;
 mod rig;
 mod target;
 
@@ -158,6 +159,9 @@ pub struct GltfOptions {
     /// Rotation keys that linear interpolation of their neighbours reproduces within this
     /// angle (degrees) are dropped; 0 keeps every key.
     pub key_tolerance_deg: f32,
+    /// Compress vertex, index and animation data with `EXT_meshopt_compression` (then
+    /// required by the file).
+    pub meshopt: bool,
     /// The level number of `lods[0]` in mesh and node names (`_LOD<k>`): a file holding one
     /// coarser level of a set names it as the set does.
     pub first_lod: usize,
@@ -174,6 +178,7 @@ impl Default for GltfOptions {
             quantize: false,
             custom_attributes: true,
             key_tolerance_deg: 0.0,
+            meshopt: false,
             first_lod: 0,
         }
     }
@@ -579,6 +584,9 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         b.bin.push(0);
     }
     b.root.buffers[0].byte_length = USize64(b.bin.len() as u64);
+    if opts.meshopt {
+        meshopt::compress(&mut b.root, &mut b.bin);
+    }
     let report = ExportReport {
         lods,
         joints: if clip.is_some() { rig.joints() } else { 0 },

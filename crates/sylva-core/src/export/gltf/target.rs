@@ -106,6 +106,7 @@ impl GltfOptions {
             quantize: true,
             custom_attributes: false,
             key_tolerance_deg: KEY_TOLERANCE_DEG,
+            meshopt: false,
             first_lod: 0,
         }
     }
