@@ -270,6 +270,51 @@ fn the_quantised_skin_reads_back_within_its_weight_rounding() {
 }
 
 #[test]
+fn the_budget_skin_moves_its_joints_segments_as_sylva_skins_them() {
+    use sylva_core::mesh::{MeshLayout, MeshParams, SkinLayout};
+    let t = tree("quaking_aspen");
+    let c = clip(&t, 1.0, false);
+    let game = GltfOptions { quantize: false, key_tolerance_deg: 0.0, ..GltfOptions::game(&t, &GAME_BUDGET) };
+    let f = read(&glb(&t, Some(&c), &game));
+    // The segments that head a joint (`segment_N`); every other one rides with its parent's.
+    let heads: std::collections::HashSet<u32> = f.json["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|n| n["name"].as_str()?.strip_prefix("segment_")?.parse().ok())
+        .collect();
+    assert!(heads.len() < t.segments.len() && heads.len() >= 64, "{} heads", heads.len());
+    let lod = game.lods[0];
+    let params = MeshParams {
+        sides: lod.sides,
+        samples: lod.samples,
+        leaf_sides: lod.leaf_sides,
+        min_stem_radius: lod.min_radius,
+        subdivide_min_edge: f32::INFINITY,
+        ..MeshParams::default()
+    };
+    let skin = SkinLayout::new(&MeshLayout::new(&t, params).unwrap());
+    // Bark vertices bound only to heads: the file's skinning is Sylva's own, to f32 rounding.
+    let h = t.height();
+    let (mut checked, mut worst) = (0, 0.0f32);
+    for k in [c.frames() / 2, c.frames() - 1] {
+        let ours = skin.skin(&c.joints[k], &c.acc[k], 1).tubes;
+        let theirs = f.skinned(k as f32 / c.fps);
+        for (i, s) in skin.tube_skin.iter().enumerate() {
+            if heads.contains(&s.bone0) && (s.weight == 0.0 || heads.contains(&s.bone1)) {
+                let d = theirs[i].0.distance(Vec3::from_array(ours[i].position));
+                worst = worst.max(d / h);
+                checked += 1;
+            }
+        }
+    }
+    println!(
+        "aspen, game skin: {checked} bark vertices on head segments within {worst:.1e} × height of Sylva's skinning"
+    );
+    assert!(checked > 1000 && worst < 1e-5, "{checked} vertices, worst {worst} × height");
+}
+
+#[test]
 fn reduced_keys_stay_within_the_stated_angle() {
     let t = tree("quaking_aspen");
     let c = clip(&t, 4.0, true);
