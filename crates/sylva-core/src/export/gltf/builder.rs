@@ -269,7 +269,7 @@ impl Builder {
             attributes.insert(Valid(Semantic::Weights(0)), w);
         }
         // The hierarchy packed in standard channels (see "Hierarchy data" in the module
-        // documentation): every importer keeps texture coordinates.
+        // documentation): importers keep texture coordinates (`TEXCOORD_1` at least).
         let e = &g.elements;
         let t1: Vec<f32> = e.iter().flat_map(|x| [x.depth + x.phase.min(PHASE_MAX), x.pivot.y]).collect();
         attributes.insert(Valid(Semantic::TexCoords(1)), self.floats(&t1, Vec2, true));

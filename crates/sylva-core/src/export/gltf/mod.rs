@@ -493,25 +493,37 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         let before = b.bin.len();
         let mut primitives = Vec::new();
         let fmt = Format { skinned: clip.is_some(), quantize: opts.quantize, custom: opts.custom_attributes };
-        let bark = Geometry::new(&skinned.tube_rest, &skinned.tube_skin, &layout.tube_indices, |_, s| {
-            hier.bark(tree, s.bone0 as usize)
-        });
-        primitives.push(b.primitive(&bark, &rig, fmt, bark_mat));
         let cards = if lod.cards { cards::cards(&layout.leaves) } else { Default::default() };
-        let (vertices, leaf_skin, indices, leaf_stride, mat) = match (lod.cards, leaf_mat, card_mat) {
-            (true, _, Some(m)) => (&cards.0, &cards.1, &cards.2, cards::CARD_VERTICES, m),
-            (false, Some(m), _) => {
-                let stride = layout.params.leaf_sides as usize + 1;
-                (&skinned.leaf_rest, &skinned.leaf_skin, &layout.leaf_indices, stride, m)
-            }
-            _ => unreachable!("a material is made for every kind of leaf a level uses"),
+        let (vertices, leaf_skin, indices, leaf_stride, leaf_material) = if lod.cards {
+            (&cards.0, &cards.1, &cards.2, cards::CARD_VERTICES, card_mat)
+        } else {
+            let stride = layout.params.leaf_sides as usize + 1;
+            (&skinned.leaf_rest, &skinned.leaf_skin, &layout.leaf_indices, stride, leaf_mat)
         };
-        if !layout.leaves.is_empty() {
-            let mut leaves =
-                Geometry::new(vertices, leaf_skin, indices, |v, _| hier.leaf(tree, &layout.leaves[v / leaf_stride]));
-            leaves.flutter = (0..vertices.len())
-                .map(|v| flutter.get(layout.leaves[v / leaf_stride].index as usize).copied().unwrap_or_default())
-                .collect();
+        // Bark and leaves side by side: their tangents (MikkTSpace) are most of a level's cost.
+        let (bark, leaves) = rayon::join(
+            || {
+                Geometry::new(&skinned.tube_rest, &skinned.tube_skin, &layout.tube_indices, |_, s| {
+                    hier.bark(tree, s.bone0 as usize)
+                })
+            },
+            || {
+                (!layout.leaves.is_empty()).then(|| {
+                    let mut g = Geometry::new(vertices, leaf_skin, indices, |v, _| {
+                        hier.leaf(tree, &layout.leaves[v / leaf_stride])
+                    });
+                    g.flutter = (0..vertices.len())
+                        .map(|v| {
+                            flutter.get(layout.leaves[v / leaf_stride].index as usize).copied().unwrap_or_default()
+                        })
+                        .collect();
+                    g
+                })
+            },
+        );
+        primitives.push(b.primitive(&bark, &rig, fmt, bark_mat));
+        // A level's leaf material is made whenever a level uses that kind of leaf.
+        if let (Some(leaves), Some(mat)) = (leaves, leaf_material) {
             primitives.push(b.primitive(&leaves, &rig, fmt, mat));
         }
         let name = format!("{}_LOD{}", tree.name, k + opts.first_lod);
