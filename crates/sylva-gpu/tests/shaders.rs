@@ -460,6 +460,8 @@ fn hsm_structs_match_their_wgsl_twins() {
             ("particles", offset_of!(RawHsmStep, particles)),
             ("max_children", offset_of!(RawHsmStep, max_children)),
             ("hold", offset_of!(RawHsmStep, hold)),
+            ("reconfiguration_speed", offset_of!(RawHsmStep, reconfiguration_speed)),
+            ("vogel_exponent", offset_of!(RawHsmStep, vogel_exponent)),
         ],
     );
 }

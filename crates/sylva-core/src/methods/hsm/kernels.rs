@@ -242,7 +242,7 @@ pub(crate) fn hsm_clusters_with<S>(
             }
         }
         if !fields.is_empty() {
-            wind_chunk_at(level, fields, waves, &info[base..base + chunk.len()], step.time, chunk);
+            wind_chunk_at(level, fields, waves, &info[base..base + chunk.len()], &step, chunk);
         }
     });
 }
@@ -287,7 +287,18 @@ fn finish_cluster(
     st.cm = [cm.x, cm.y, cm.z, weight];
     st.rotation = q.to_array();
     st.transform = [t.x_axis.extend(shift.x).into(), t.y_axis.extend(shift.y).into(), t.z_axis.extend(shift.z).into()];
-    st.wind = [0.0; 4];
+    st.wind = [0.0, 0.0, 0.0, 1.0];
+}
+
+/// Vogel's reconfiguration of the drag of a cluster's particles in the wind `u` at its
+/// centre, the factor `g(|u|)` of [`crate::physics::DragModel::reconfiguration`] with the
+/// step's U_r and B: parts that move with the air far slower than it (all but a gust's first
+/// instants) streamline with the wind's own speed, so one factor per cluster and substep
+/// serves all its particles. 1 in still air. WGSL: `hsm_reconfiguration`.
+#[inline(always)]
+pub fn reconfiguration(u: Vec3, step: &RawHsmStep) -> f32 {
+    let r = u.length() / step.reconfiguration_speed;
+    if r > 0.0 { (1.0 + r * r).powf(0.5 * step.vogel_exponent) } else { 1.0 }
 }
 
 /// Lane `t`'s sums as invocation `t` of `hsm_clusters.wgsl` adds them: zero, plus slot `t`,
@@ -356,24 +367,26 @@ pub(crate) fn cluster_sums(
 }
 
 dispatch! {
-/// The wind at the centres of one chunk's segment clusters (a leaf feels the wind sampled
-/// for its segment: stage 4 reads it there, and a leaf cluster's stays zero). The WGSL
+/// The wind at the centres of one chunk's segment clusters, with its [`reconfiguration`]
+/// in w (a leaf feels the wind sampled for its segment: stage 4 reads it there, and a leaf
+/// cluster's stays zero). The WGSL
 /// samples it in the cluster's own invocation; here sixteen centres at a time
 /// ([`crate::wind::lanes`]).
 fn wind_chunk_at(
     fields: &[RawField],
     waves: &[RawWave],
     info: &[RawHsmClusterInfo],
-    time: f32,
+    step: &RawHsmStep,
     state: &mut [RawHsmClusterState],
 ) {
+    let time = step.time;
     let segments: Vec<usize> = (0..state.len()).filter(|&j| info[j].kind != kind::LEAF).collect();
     for group in segments.chunks(WIND_LANES) {
         let centre = |l: usize| v3(state[group[l.min(group.len() - 1)]].cm);
         let u = wind_lanes(fields, waves, V3::from_lanes(std::array::from_fn(centre)), time);
         for (l, &j) in group.iter().enumerate() {
             let w = u.lane(l);
-            state[j].wind = [w.x, w.y, w.z, 0.0];
+            state[j].wind = [w.x, w.y, w.z, reconfiguration(w, step)];
         }
     }
 }
@@ -409,7 +422,8 @@ fn goal_displacement(st: &RawHsmClusterState, q: Vec3A) -> Vec3A {
 /// A free particle's new velocity: the pull toward goal `g` (w = Σ w, ᾱ its minimum with
 /// the hold) from `u` (both
 /// displacements from rest, so `g − u` is the goal minus the position), gravity,
-/// semi-implicit drag toward `wind` with drag factor `kd`, damping. WGSL: `hsm_velocity`.
+/// semi-implicit drag toward `wind` with drag factor `kd` (its own times its owner's
+/// [`reconfiguration`]), damping. WGSL: `hsm_velocity`.
 #[inline(always)]
 fn particle_velocity(v: Vec3A, g: [f32; 4], u: Vec3A, wind: Vec3A, kd: f32, step: &RawHsmStep) -> Vec3A {
     let h = step.dt;
@@ -501,7 +515,8 @@ fn integrate_free(
                 continue; // fixed
             }
             let u = a3(*x);
-            let vel = particle_velocity(a3(*v), goal_of(base + i), u, a3(state[*o as usize].wind), kd, &step);
+            let wind = state[*o as usize].wind;
+            let vel = particle_velocity(a3(*v), goal_of(base + i), u, a3(wind), kd * wind[3], &step);
             *x = with_xyz(u + vel * step.dt, x[3]);
             *v = with_xyz(vel, kd);
         }
@@ -577,7 +592,7 @@ mod tests {
 
     /// The cluster wind compiled for AVX2 (where the CPU has it) and for the baseline gives
     /// the same bits, at random centres and times, on every wind preset; leaf clusters keep
-    /// zero wind.
+    /// zero wind; a segment's w is the drag's reconfiguration at its wind.
     #[test]
     fn cluster_wind_is_the_same_at_every_level() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
@@ -602,15 +617,27 @@ mod tests {
                         ..bytemuck::Zeroable::zeroed()
                     })
                     .collect();
+                let drag = crate::physics::DragModel::default();
+                let step = RawHsmStep {
+                    time,
+                    reconfiguration_speed: drag.reconfiguration_speed,
+                    vogel_exponent: drag.vogel_exponent,
+                    ..bytemuck::Zeroable::zeroed()
+                };
                 let run = |level: Level| {
                     let mut s = state.clone();
-                    wind_chunk_at(level, &fields, &waves, &info, time, &mut s);
+                    wind_chunk_at(level, &fields, &waves, &info, &step, &mut s);
                     s
                 };
                 let base = run(Level::Baseline);
                 for (i, s) in base.iter().enumerate() {
                     let moving = s.wind[..3].iter().any(|&w| w != 0.0);
                     assert_eq!(moving, info[i].kind != kind::LEAF, "{name}: cluster {i} wind {:?}", s.wind);
+                    if moving {
+                        // w is the reconfiguration at the wind's speed.
+                        let g = drag.reconfiguration(Vec3::from_slice(&s.wind[..3]).length());
+                        assert!((s.wind[3] - g).abs() <= 1e-6 * g, "{name}: cluster {i} w {} against {g}", s.wind[3]);
+                    }
                 }
                 let bits =
                     |s: &[RawHsmClusterState]| s.iter().flat_map(|c| c.wind.map(f32::to_bits)).collect::<Vec<_>>();

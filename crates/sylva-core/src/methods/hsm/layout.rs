@@ -127,7 +127,7 @@ impl HsmLayout {
             let floor = tree.wood.segment_mass(len, params.min_radius, params.min_radius);
             let m = s.mass[i].max(floor).max(1e-9) / own;
             let area = (s.radius_base[i].max(params.min_radius) + s.radius_tip[i].max(params.min_radius)) * len / own;
-            let kd = 0.5 * AIR_DENSITY * params.drag * area / m;
+            let kd = 0.5 * AIR_DENSITY * params.drag * params.drag_scale * area / m;
             let slot_offset = slot_particles.len() as u32;
             let mut my_rings = Vec::with_capacity(rings);
             let parent_cluster =
@@ -193,7 +193,7 @@ impl HsmLayout {
                 let (w, h) = (l.width[leaf], l.length[leaf]);
                 let blade = std::f32::consts::FRAC_PI_4 * w * h;
                 let m = (blade * tree.wood.leaf_areal_density).max(1e-9) / n as f32;
-                let kd = 0.5 * AIR_DENSITY * params.leaf_drag * blade / n as f32 / m;
+                let kd = 0.5 * AIR_DENSITY * params.leaf_drag * params.drag_scale * blade / n as f32 / m;
                 let slot_offset = slot_particles.len() as u32;
                 let (centre, first) = b.nearest_ring(c, l.position[leaf]);
                 slot_particles.extend(first..first + k as u32);

@@ -80,7 +80,9 @@ pub struct RawHsmClusterState {
     /// Columns of the goal transform T (xyz); the w components are the centre's shift
     /// from rest `c − c⁰` (x, y, z), which goals are built from.
     pub transform: [[f32; 4]; 3],
-    /// Wind velocity at the centre of mass (xyz), m/s.
+    /// Wind velocity at the centre of mass (xyz), m/s; w = the drag's reconfiguration factor
+    /// there ([`super::kernels::reconfiguration`]; 1 for a leaf cluster, whose particles feel
+    /// their segment's).
     pub wind: [f32; 4],
 }
 
@@ -91,12 +93,12 @@ impl RawHsmClusterState {
             cm: [c.rest_cm[0], c.rest_cm[1], c.rest_cm[2], 0.0],
             rotation: [0.0, 0.0, 0.0, 1.0],
             transform: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]],
-            wind: [0.0; 4],
+            wind: [0.0, 0.0, 0.0, 1.0],
         }
     }
 }
 
-/// Per-substep values and tree information, 48 bytes. WGSL: `HsmStep`.
+/// Per-substep values and tree information, 64 bytes. WGSL: `HsmStep`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawHsmStep {
@@ -122,8 +124,12 @@ pub struct RawHsmStep {
     /// and the least bound on a cluster's weight: `s (r h)²` for substep rate `r` and rate
     /// scale `s` (see [`super::HsmParams::substep_rate`]), never above 1.
     pub hold: f32,
+    /// [`super::HsmParams::reconfiguration_speed`], m/s.
+    pub reconfiguration_speed: f32,
+    /// [`super::HsmParams::vogel_exponent`].
+    pub vogel_exponent: f32,
     /// Padding to 16 bytes.
-    pub _pad: [f32; 3],
+    pub _pad: f32,
 }
 
 /// [`super::HsmState::velocity`]'s w for a fixed particle (free ones carry their drag factor ≥ 0).

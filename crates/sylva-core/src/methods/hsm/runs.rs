@@ -309,6 +309,7 @@ pub(crate) mod avx2 {
             let wsum_v = _mm256_set1_ps(wsum);
             let scale = _mm256_set1_ps(if weighted { wsum.min(step.hold) * inv_h } else { 0.0 });
             let wind: [__m256; 3] = std::array::from_fn(|c| _mm256_set1_ps(state[run.owner as usize].wind[c]));
+            let reconfigured = _mm256_set1_ps(state[run.owner as usize].wind[3]);
             let len = run.len as usize;
             let padded = len.next_multiple_of(WIDTH);
             let first = run.first as usize - base;
@@ -358,7 +359,7 @@ pub(crate) mod avx2 {
                     _mm256_add_ps(_mm256_mul_ps(rel[0], rel[0]), _mm256_mul_ps(rel[1], rel[1])),
                     _mm256_mul_ps(rel[2], rel[2]),
                 );
-                let s = _mm256_mul_ps(_mm256_mul_ps(hs, kd), _mm256_sqrt_ps(dot));
+                let s = _mm256_mul_ps(_mm256_mul_ps(hs, _mm256_mul_ps(kd, reconfigured)), _mm256_sqrt_ps(dot));
                 let f = _mm256_div_ps(s, _mm256_add_ps(one, s));
                 for a in 0..3 {
                     vel[a] = _mm256_mul_ps(_mm256_add_ps(vel[a], _mm256_mul_ps(rel[a], f)), damping);

@@ -64,6 +64,18 @@ struct HsmStep {
     particles: u32,
     max_children: u32,
     hold: f32,
+    reconfiguration_speed: f32,
+    vogel_exponent: f32,
+}
+
+// Vogel's reconfiguration of a cluster's drag in the wind `u` at its centre, (1 + r²)^(B/2)
+// with r = |u| / U_r; 1 in still air. CPU twin: kernels::reconfiguration.
+fn hsm_reconfiguration(u: vec3<f32>, step: HsmStep) -> f32 {
+    let r = length(u) / step.reconfiguration_speed;
+    if (r > 0.0) {
+        return pow(1.0 + r * r, 0.5 * step.vogel_exponent);
+    }
+    return 1.0;
 }
 
 // Rotation matrix of a unit quaternion (as glam's Mat3::from_quat).

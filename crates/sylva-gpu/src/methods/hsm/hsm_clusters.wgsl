@@ -97,5 +97,5 @@ fn main(
         vec4<f32>(tr[1], shift.y),
         vec4<f32>(tr[2], shift.z),
     );
-    state[c].wind = vec4<f32>(u, 0.0);
+    state[c].wind = vec4<f32>(u, hsm_reconfiguration(u, step));
 }
