@@ -297,8 +297,11 @@ fn finish_cluster(
 /// serves all its particles. 1 in still air. WGSL: `hsm_reconfiguration`.
 #[inline(always)]
 pub fn reconfiguration(u: Vec3, step: &RawHsmStep) -> f32 {
-    let r = u.length() / step.reconfiguration_speed;
-    if r > 0.0 { (1.0 + r * r).powf(0.5 * step.vogel_exponent) } else { 1.0 }
+    let drag = crate::physics::DragModel {
+        reconfiguration_speed: step.reconfiguration_speed,
+        vogel_exponent: step.vogel_exponent,
+    };
+    drag.reconfiguration(u.length())
 }
 
 /// Lane `t`'s sums as invocation `t` of `hsm_clusters.wgsl` adds them: zero, plus slot `t`,
@@ -369,7 +372,7 @@ pub(crate) fn cluster_sums(
 dispatch! {
 /// The wind at the centres of one chunk's segment clusters, with its [`reconfiguration`]
 /// in w (a leaf feels the wind sampled for its segment: stage 4 reads it there, and a leaf
-/// cluster's stays zero). The WGSL
+/// cluster's stays still air, w = 1). The WGSL
 /// samples it in the cluster's own invocation; here sixteen centres at a time
 /// ([`crate::wind::lanes`]).
 fn wind_chunk_at(
