@@ -9,7 +9,10 @@
 //! per submission, wall clock to completion. The paper's figures include drawing (about
 //! 0.1 % of its CPU time); ours time generation only.
 
-use crate::harness::{Env, Machine, markdown_head, measure, measure_gpu, write_atomic};
+use crate::harness::{
+    COMMANDS_HEADING, Commands, Env, Machine, commands_cell, count_gpu, markdown_head, measure, measure_gpu,
+    write_atomic,
+};
 use crate::plot::{Series, plot_series};
 use crate::tables::AKAGI_TABLE_2;
 use anyhow::{Context, Result};
@@ -47,6 +50,8 @@ pub struct AkagiRow {
     pub cpu_all_ms: Option<[f64; 3]>,
     /// GPU, ms per frame.
     pub gpu_ms: Option<[f64; 3]>,
+    /// The GPU's commands per frame.
+    pub gpu_commands: Option<Commands>,
     /// CPU (all threads) bytes/s over the measured copy bandwidth.
     pub cpu_bandwidth_fraction: Option<f64>,
     /// GPU bytes/s over the measured copy bandwidth.
@@ -154,21 +159,22 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         } else {
             (None, None)
         };
-        let gpu = match ctx {
+        let (gpu, gpu_commands) = match ctx {
             Some(c) => {
                 let mesh = sylva_gpu::mesh::GpuMesh::new(c, &layout)?;
                 let jb = sylva_gpu::kernel::upload(c, "bench joints", &joint)?;
                 let ab = sylva_gpu::kernel::upload(c, "bench rotations", &acc)?;
-                Some(measure_gpu(budget, c, |n| {
+                let mut frames = |n| {
                     let mut e = c.device.create_command_encoder(&Default::default());
                     for _ in 0..n {
                         mesh.record(c, &mut e, &jb, &ab);
                     }
-                    c.queue.submit([e.finish()]);
+                    c.submit([e.finish()]);
                     Ok(())
-                })?)
+                };
+                (Some(measure_gpu(budget, c, &mut frames)?), Some(count_gpu(c, &mut frames)?))
             }
-            None => None,
+            None => (None, None),
         };
         let row = AkagiRow {
             paper_triangles,
@@ -181,6 +187,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             cpu_one_ms: cpu_one.map(|r| r.ms()),
             cpu_all_ms: cpu_all.map(|r| r.ms()),
             gpu_ms: gpu.map(|r| r.ms()),
+            gpu_commands,
             cpu_bandwidth_fraction: cpu_all.map(|r| r.median * bytes as f64 / cpu_bw),
             gpu_bandwidth_fraction: gpu.zip(gpu_bw).map(|(r, b)| r.median * bytes as f64 / b),
         };
@@ -203,15 +210,19 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
 
     let mut md = markdown_head("Akagi & Kitajima Table 2: mesh regeneration per frame", "akagi-t2", env.machine);
     md += "ms per frame, median (min–max). The paper: Core2 QX9650 one thread, GeForce GTX 280, generation + drawing.\n\n";
-    md += "| paper triangles | paper CPU ms | paper GPU ms | paper CPU/GPU | triangles | trees | MB/frame | CPU 1 thread ms | CPU all threads ms | CPU % of bandwidth | GPU ms | GPU % of bandwidth | CPU 1 thread / GPU | CPU all / GPU |\n";
-    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    md += &format!(
+        "| paper triangles | paper CPU ms | paper GPU ms | paper CPU/GPU | triangles | trees | MB/frame | CPU 1 thread ms | CPU all threads ms | CPU % of bandwidth | GPU ms | GPU % of bandwidth | CPU 1 thread / GPU | CPU all / GPU | {} |\n",
+        COMMANDS_HEADING.replace("step", "frame")
+    );
+    md +=
+        "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let ratio = |a: Option<[f64; 3]>, b: Option<[f64; 3]>| match (a, b) {
         (Some(a), Some(b)) => format!("{:.1}", a[0] / b[0]),
         _ => "–".into(),
     };
     for r in &out {
         md += &format!(
-            "| {} | {:.2} | {:.3} | {:.0} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {:.2} | {:.3} | {:.0} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.paper_triangles,
             r.paper_cpu_ms,
             r.paper_gpu_ms,
@@ -226,6 +237,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             r.gpu_bandwidth_fraction.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f)),
             ratio(r.cpu_one_ms, r.gpu_ms),
             ratio(r.cpu_all_ms, r.gpu_ms),
+            commands_cell(r.gpu_commands),
         );
     }
     let json = serde_json::to_string_pretty(&Report { table: "akagi-t2", machine: env.machine, rows: &out })?;

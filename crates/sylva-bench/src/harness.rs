@@ -108,6 +108,51 @@ pub fn measure_gpu(budget: f64, ctx: &sylva_gpu::GpuContext, mut f: impl FnMut(u
     })
 }
 
+/// Steps a GPU row's commands are counted over ([`count_gpu`]): one second at 60 Hz.
+pub const COUNTED_STEPS: usize = 60;
+
+/// The commands a GPU row records and submits per step, counted on the context over
+/// [`COUNTED_STEPS`] steps run as the timed samples run them: what a step costs the driver
+/// and the queue, beside the bytes it moves.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Commands {
+    /// Compute dispatches per step.
+    pub dispatches: f64,
+    /// Compute passes per step.
+    pub passes: f64,
+    /// Bind groups created per step.
+    pub bind_groups: f64,
+    /// Queue submissions per step.
+    pub submissions: f64,
+}
+
+/// Counts the commands of `f(COUNTED_STEPS)` ([`Commands`]); waits for the GPU.
+pub fn count_gpu(ctx: &sylva_gpu::GpuContext, mut f: impl FnMut(usize) -> Result<()>) -> Result<Commands> {
+    ctx.wait()?;
+    let before = ctx.counts();
+    f(COUNTED_STEPS)?;
+    ctx.wait()?;
+    let d = ctx.counts() - before;
+    let per = |x: u64| x as f64 / COUNTED_STEPS as f64;
+    Ok(Commands {
+        dispatches: per(d.dispatches),
+        passes: per(d.passes),
+        bind_groups: per(d.bind_groups),
+        submissions: per(d.submissions),
+    })
+}
+
+/// The heading of the commands column.
+pub const COMMANDS_HEADING: &str = "GPU dispatches / passes / bind groups / submissions per step";
+
+/// A commands cell: `dispatches / passes / bind groups / submissions`, whole numbers plain.
+pub fn commands_cell(c: Option<Commands>) -> String {
+    let num = |x: f64| if x == x.round() { format!("{x:.0}") } else { format!("{x:.3}") };
+    c.map_or("–".into(), |c| {
+        format!("{} / {} / {} / {}", num(c.dispatches), num(c.passes), num(c.bind_groups), num(c.submissions))
+    })
+}
+
 /// The sampling loop: `f(n)` runs n steps and returns (seconds, timed by timestamps).
 fn sample(budget: f64, mut f: impl FnMut(usize) -> Result<(f64, bool)>) -> Result<Rate> {
     let one = f(1)?.0.max(1e-7);
@@ -179,7 +224,7 @@ pub fn gpu_bandwidth(ctx: &sylva_gpu::GpuContext) -> Result<f64> {
         e.copy_buffer_to_buffer(&a, 0, &b, 0, bytes);
         ctx.wait()?;
         let t0 = Instant::now();
-        ctx.queue.submit([e.finish()]);
+        ctx.submit([e.finish()]);
         ctx.wait()?;
         best = best.min(t0.elapsed().as_secs_f64());
     }

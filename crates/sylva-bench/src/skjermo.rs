@@ -7,11 +7,14 @@
 //! 15–17), the two state buffers ping-ponging; no pose, no mesh. The wind is the paper's
 //! setting, four sines (eqs. 11–14). CPU rows time the fast path (sixteen stems per lane
 //! group, rayon) and the reference kernel (one stem at a time, the WGSL's twin); GPU rows
-//! `skjermo.wgsl`, one dispatch per update. `--quick` times 4,095 and 16,383 branches
-//! instead (no paper figure).
+//! `skjermo.wgsl`, one dispatch per update, a sample's updates in one submission. `--quick`
+//! times 4,095 and 16,383 branches instead (no paper figure).
 
 use crate::akagi::Report;
-use crate::harness::{Env, Rate, markdown_head, measure, measure_gpu, rate_cell as rate, write_atomic};
+use crate::harness::{
+    COMMANDS_HEADING, Commands, Env, Rate, commands_cell, count_gpu, markdown_head, measure, measure_gpu,
+    rate_cell as rate, write_atomic,
+};
 use crate::plot::{Series, plot_series};
 use crate::tables::{BENCH_BINARY_TREE, BENCH_FOUR_SINES, SKJERMO_FIGURE};
 use anyhow::{Context, Result};
@@ -48,6 +51,8 @@ pub struct SkjermoRow {
     pub cpu_reference: Option<Rate>,
     /// GPU, updates/s.
     pub gpu: Option<Rate>,
+    /// The GPU's commands per update.
+    pub gpu_commands: Option<Commands>,
     /// CPU bytes/s over the measured copy bandwidth.
     pub cpu_bandwidth_fraction: Option<f64>,
     /// GPU bytes/s over the measured copy bandwidth.
@@ -106,7 +111,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         } else {
             (None, None, None)
         };
-        let gpu = match env.ctx {
+        let (gpu, gpu_commands) = match env.ctx {
             Some(c) => {
                 let mut g = sylva_gpu::methods::skjermo::GpuSkjermo::new(
                     c,
@@ -114,14 +119,14 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                     &m,
                     &sylva_gpu::wind::GpuWind::from_scene(c, &wind)?,
                 )?;
-                Some(measure_gpu(env.budget, c, |k| {
-                    for _ in 0..k {
-                        g.step_only(c, dt);
-                    }
+                // A sample's updates in one submission, as a frame's substeps would be.
+                let mut updates = |k| {
+                    g.advance_steps(c, dt, k, false);
                     Ok(())
-                })?)
+                };
+                (Some(measure_gpu(env.budget, c, &mut updates)?), Some(count_gpu(c, &mut updates)?))
             }
-            None => None,
+            None => (None, None),
         };
         let row = SkjermoRow {
             paper_branches: paper.map(|p| p.0),
@@ -135,6 +140,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             cpu_published,
             cpu_reference,
             gpu,
+            gpu_commands,
         };
         bar.suspend(|| {
             println!(
@@ -162,8 +168,12 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         std::mem::size_of::<StemLanes>() / sylva_core::methods::skjermo::lanes::LANES,
         std::mem::size_of::<RawSkjermoStem>()
     );
-    md += "| paper branches | paper updates/s | branches | MB/update (CPU / GPU) | CPU updates/s | CPU, published form | CPU / published | CPU reference kernel | CPU / paper | CPU % of bandwidth | GPU updates/s | GPU / paper | GPU % of bandwidth | GPU / CPU |\n";
-    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    md += &format!(
+        "| paper branches | paper updates/s | branches | MB/update (CPU / GPU) | CPU updates/s | CPU, published form | CPU / published | CPU reference kernel | CPU / paper | CPU % of bandwidth | GPU updates/s | GPU / paper | GPU % of bandwidth | GPU / CPU | {} |\n",
+        COMMANDS_HEADING.replace("step", "update")
+    );
+    md +=
+        "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let over = |r: Option<Rate>, p: Option<f64>| match (r, p) {
         (Some(r), Some(p)) => format!("{:.2}", r.median / p),
         _ => "–".into(),
@@ -171,7 +181,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     let pct = |f: Option<f64>| f.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f));
     for r in &out {
         md += &format!(
-            "| {} | {} | {} | {:.1} / {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {:.1} / {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.paper_branches.map_or("–".into(), |b| b.to_string()),
             r.paper_updates_per_s.map_or("–".into(), |p| format!("{p:.0}")),
             r.branches,
@@ -190,6 +200,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                 (Some(g), Some(c)) => format!("{:.2}", g.median / c.median),
                 _ => "–".into(),
             },
+            commands_cell(r.gpu_commands),
         );
     }
     let json = serde_json::to_string_pretty(&Report { table: "skjermo", machine: env.machine, rows: &out })?;

@@ -2,7 +2,8 @@
 //! number of clusters, one tree and ten, on the CPU and the GPU.
 
 use crate::harness::{
-    Env, Machine, Rate, frac_cell, markdown_head, measure, measure_gpu, rate_cell, ratio_cell, write_atomic,
+    COMMANDS_HEADING, Commands, Env, Machine, Rate, commands_cell, count_gpu, frac_cell, markdown_head, measure,
+    measure_gpu, rate_cell, ratio_cell, write_atomic,
 };
 use crate::plot::plot_series;
 use crate::tables::{SONG_TABLE_2, SONG_TABLE_3};
@@ -39,6 +40,8 @@ pub struct Row {
     pub cpu: Option<Rate>,
     /// GPU steps per second.
     pub gpu: Option<Rate>,
+    /// The GPU's commands per step.
+    pub gpu_commands: Option<Commands>,
     /// CPU bytes per second over the measured CPU copy bandwidth.
     pub cpu_bandwidth_fraction: Option<f64>,
     /// GPU bytes per second over the measured GPU copy bandwidth.
@@ -91,16 +94,17 @@ pub fn run(env: &Env<'_>, tree: &Tree, table3: bool) -> Result<Vec<PathBuf>> {
             })
         });
         let cpu = cpu.transpose()?;
-        let gpu = match env.ctx {
+        let (gpu, gpu_commands) = match env.ctx {
             Some(c) => {
                 let mut g =
                     sylva_gpu::methods::hsm::GpuHsm::new(c, None, hsm.clone(), &GpuWind::from_scene(c, &wind)?)?;
-                Some(measure_gpu(env.budget, c, |n| {
+                let mut steps = |n| {
                     g.advance_steps(c, dt, n);
                     Ok(())
-                })?)
+                };
+                (Some(measure_gpu(env.budget, c, &mut steps)?), Some(count_gpu(c, &mut steps)?))
             }
-            None => None,
+            None => (None, None),
         };
         let machine = env.machine;
         let row = Row {
@@ -115,6 +119,7 @@ pub fn run(env: &Env<'_>, tree: &Tree, table3: bool) -> Result<Vec<PathBuf>> {
             gpu_bandwidth_fraction: gpu.zip(machine.gpu_bandwidth).map(|(r, b)| r.median * bytes as f64 / b),
             cpu,
             gpu,
+            gpu_commands,
         };
         bar.suspend(|| println!("{}", row_line(&row)));
         out.push(row);
@@ -145,15 +150,17 @@ fn row_line(r: &Row) -> String {
 
 fn markdown(rep: &Report) -> String {
     let mut s = markdown_head(&rep.title, &rep.table, &rep.machine);
-    s += "| paper clusters | paper particles | paper steps/s (GTX 580) | clusters | particles | CPU MB/step | CPU steps/s (median, min–max) | CPU / paper | CPU % of bandwidth | GPU MB/step | GPU steps/s | GPU / paper | GPU % of bandwidth | GPU / CPU |\n";
-    s += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    s += &format!(
+        "| paper clusters | paper particles | paper steps/s (GTX 580) | clusters | particles | CPU MB/step | CPU steps/s (median, min–max) | CPU / paper | CPU % of bandwidth | GPU MB/step | GPU steps/s | GPU / paper | GPU % of bandwidth | GPU / CPU | {COMMANDS_HEADING} |\n"
+    );
+    s += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     for r in &rep.rows {
         let gpu_cpu = match (r.gpu, r.cpu) {
             (Some(g), Some(c)) => format!("{:.2}", g.median / c.median),
             _ => "–".into(),
         };
         s += &format!(
-            "| {} | {} | {:.0} | {} | {} | {:.2} | {} | {} | {} | {:.2} | {} | {} | {} | {} |\n",
+            "| {} | {} | {:.0} | {} | {} | {:.2} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} |\n",
             r.paper_clusters,
             r.paper_particles,
             r.paper_fps,
@@ -167,7 +174,8 @@ fn markdown(rep: &Report) -> String {
             rate_cell(r.gpu),
             ratio_cell(r.gpu, r.paper_fps),
             frac_cell(r.gpu_bandwidth_fraction),
-            gpu_cpu
+            gpu_cpu,
+            commands_cell(r.gpu_commands),
         );
     }
     s

@@ -15,7 +15,9 @@
 //!   branch simulation" column.
 
 use crate::akagi::{Report, cell};
-use crate::harness::{Env, markdown_head, measure, measure_gpu, write_atomic};
+use crate::harness::{
+    COMMANDS_HEADING, Commands, Env, commands_cell, count_gpu, markdown_head, measure, measure_gpu, write_atomic,
+};
 use crate::plot::{Series, plot_series};
 use crate::tables::ZIOMA_TABLE_6_1;
 use anyhow::{Context, Result};
@@ -71,6 +73,8 @@ pub struct ZiomaRow {
     pub gpu_frame_slod2_ms: Option<[f64; 3]>,
     /// GPU skinning only ms.
     pub gpu_skin_ms: Option<[f64; 3]>,
+    /// The GPU frame's commands (pose and skinning, SLOD3).
+    pub gpu_frame_commands: Option<Commands>,
     /// How the GPU was timed.
     pub gpu_clock: Option<&'static str>,
     /// Why the GPU skinning columns are empty, when they are (one instance's skinned
@@ -153,7 +157,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             (None, None, None, None)
         };
         let mut gpu_skin_skipped = None;
-        let (gpu_pose, gpu_frame, gpu_frame_slod2, gpu_skin) = match env.ctx {
+        let (gpu_pose, gpu_frame, gpu_frame_slod2, gpu_skin, gpu_frame_commands) = match env.ctx {
             Some(c) => {
                 let gpu_wind = sylva_gpu::wind::GpuWind::from_scene(c, &wind)?;
                 let shared = std::sync::Arc::new(tree.clone());
@@ -182,21 +186,22 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                     }
                     Err(e) => return Err(e).context("skinning every instance on the GPU"),
                 };
-                let (frame, frame_slod2, skin_only) = match gs {
+                let (frame, frame_slod2, skin_only, commands) = match gs {
                     Some(gs) => {
-                        let mut frame = |g: &mut sylva_gpu::methods::zioma::GpuZioma| {
-                            measure_gpu(env.budget, c, |n| {
-                                for _ in 0..n {
-                                    g.submit(c, tick());
-                                    let mut e = c.device.create_command_encoder(&Default::default());
-                                    let pose = g.pose_buffers();
-                                    gs.record(c, &mut e, pose.joints_buffer(), pose.acc_buffer());
-                                    c.queue.submit([e.finish()]);
-                                }
-                                Ok(())
-                            })
+                        let mut frames = |g: &mut sylva_gpu::methods::zioma::GpuZioma, n| {
+                            for _ in 0..n {
+                                // Pose and skinning in one submission.
+                                let mut e = c.device.create_command_encoder(&Default::default());
+                                g.record(c, &mut e, tick());
+                                let pose = g.pose_buffers();
+                                gs.record(c, &mut e, pose.joints_buffer(), pose.acc_buffer());
+                                c.submit([e.finish()]);
+                            }
+                            Ok(())
                         };
-                        let (frame, frame_slod2) = (frame(&mut g)?, frame(&mut g2)?);
+                        let frame = measure_gpu(env.budget, c, |n| frames(&mut g, n))?;
+                        let commands = count_gpu(c, |n| frames(&mut g, n))?;
+                        let frame_slod2 = measure_gpu(env.budget, c, |n| frames(&mut g2, n))?;
                         let jb = sylva_gpu::kernel::upload(c, "rest joints", &rest_joint)?;
                         let ab = sylva_gpu::kernel::upload(c, "rest rotations", &rest_acc)?;
                         let skin_only = measure_gpu(env.budget, c, |n| {
@@ -204,16 +209,16 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                             for _ in 0..n {
                                 gs.record(c, &mut e, &jb, &ab);
                             }
-                            c.queue.submit([e.finish()]);
+                            c.submit([e.finish()]);
                             Ok(())
                         })?;
-                        (Some(frame), Some(frame_slod2), Some(skin_only))
+                        (Some(frame), Some(frame_slod2), Some(skin_only), Some(commands))
                     }
-                    None => (None, None, None),
+                    None => (None, None, None, None),
                 };
-                (Some(pose), frame, frame_slod2, skin_only)
+                (Some(pose), frame, frame_slod2, skin_only, commands)
             }
-            None => (None, None, None, None),
+            None => (None, None, None, None, None),
         };
         let row = ZiomaRow {
             instances,
@@ -233,6 +238,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             gpu_frame_ms: gpu_frame.map(|r| r.ms()),
             gpu_frame_slod2_ms: gpu_frame_slod2.map(|r| r.ms()),
             gpu_skin_ms: gpu_skin.map(|r| r.ms()),
+            gpu_frame_commands,
             gpu_clock: gpu_pose.map(|r| r.clock),
             gpu_skin_skipped,
             cpu_bandwidth_fraction: cpu_frame.map(|r| r.median * bytes as f64 / env.machine.cpu_bandwidth),
@@ -268,13 +274,16 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
          columns, Xeon 2.33 GHz + GeForce 8800 GTX) at SLOD3 (trunk and branches) and SLOD2 (trunk only); \
          skinning only = from a fixed pose (the paper's skinning without branch simulation).\n\n"
     );
-    md += "| instances | branches | paper DX9 ms | paper DX10 SLOD3 ms | paper DX10 SLOD2 ms | paper skinning ms | MB/frame | CPU pose ms | CPU frame ms | CPU SLOD2 frame ms | CPU skinning ms | CPU frame / paper DX10 | CPU SLOD2 / paper SLOD2 | CPU % of bandwidth | GPU pose ms | GPU frame ms | GPU SLOD2 frame ms | GPU skinning ms | GPU frame / paper DX10 | GPU SLOD2 / paper SLOD2 | GPU % of bandwidth | CPU / GPU frame |\n";
-    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    md += &format!(
+        "| instances | branches | paper DX9 ms | paper DX10 SLOD3 ms | paper DX10 SLOD2 ms | paper skinning ms | MB/frame | CPU pose ms | CPU frame ms | CPU SLOD2 frame ms | CPU skinning ms | CPU frame / paper DX10 | CPU SLOD2 / paper SLOD2 | CPU % of bandwidth | GPU pose ms | GPU frame ms | GPU SLOD2 frame ms | GPU skinning ms | GPU frame / paper DX10 | GPU SLOD2 / paper SLOD2 | GPU % of bandwidth | CPU / GPU frame | {} (frame) |\n",
+        COMMANDS_HEADING.replace("step", "frame")
+    );
+    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let over = |a: Option<[f64; 3]>, b: f64| a.map_or("–".into(), |a| format!("{:.2}", a[0] / b));
     let pct = |f: Option<f64>| f.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f));
     for r in &out {
         md += &format!(
-            "| {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.instances,
             r.branches,
             r.paper_dx9_ms,
@@ -300,6 +309,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                 (Some(c), Some(g)) => format!("{:.2}", c[0] / g[0]),
                 _ => "–".into(),
             },
+            commands_cell(r.gpu_frame_commands),
         );
     }
     for r in out.iter().filter(|r| r.gpu_skin_skipped.is_some()) {

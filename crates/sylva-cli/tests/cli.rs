@@ -621,6 +621,15 @@ fn bench_quick_writes_complete_tables() {
             assert!(cpu["median"].as_f64().unwrap() <= cpu["max"].as_f64().unwrap());
             assert!(cpu["samples"].as_u64().unwrap() >= 3);
             assert_eq!(r["gpu"].is_null(), !gpu);
+            // The work model: a step's two dispatches (stage 1, the fused particle pass)
+            // per substep share a pass on bind groups made once; a sample is one submission.
+            let commands = &r["gpu_commands"];
+            assert_eq!(commands.is_null(), !gpu);
+            if gpu {
+                let [d, p, b, s] =
+                    ["dispatches", "passes", "bind_groups", "submissions"].map(|k| commands[k].as_f64().unwrap());
+                assert!(d >= 2.0 && d == 2.0 * p && b == 0.0 && s < 1.0, "{commands}");
+            }
         }
         let md = std::fs::read_to_string(dir.path().join(format!("b/{table}.md"))).unwrap();
         assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 2 + 3, "{md}");
@@ -640,6 +649,13 @@ fn bench_quick_writes_complete_tables() {
             assert!(lo <= m && m <= hi && m > 0.0, "{key}: {m} ({lo}–{hi})");
         }
         assert_eq!(r["gpu_ms"].is_null(), !gpu);
+        // Bark rings, their midpoints and the leaves: three dispatches in one pass.
+        if gpu {
+            let commands = &r["gpu_commands"];
+            assert_eq!(commands["dispatches"].as_f64(), Some(3.0), "{commands}");
+            assert_eq!(commands["passes"].as_f64(), Some(1.0), "{commands}");
+            assert_eq!(commands["bind_groups"].as_f64(), Some(0.0), "{commands}");
+        }
     }
     let md = std::fs::read_to_string(dir.path().join("b/akagi-t2.md")).unwrap();
     assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 2 + 3, "{md}");
@@ -675,6 +691,12 @@ fn bench_quick_writes_complete_tables() {
             assert!(lo <= m && m <= hi && m > 0.0, "{key}: {m} ({lo}–{hi})");
         }
         assert!(r["cpu_bandwidth_fraction"].as_f64().unwrap() > 0.0);
+        // Pose and skinning of a frame in one submission, on bind groups made once.
+        if gpu {
+            let commands = &r["gpu_frame_commands"];
+            assert_eq!(commands["submissions"].as_f64(), Some(1.0), "{commands}");
+            assert_eq!(commands["bind_groups"].as_f64(), Some(0.0), "{commands}");
+        }
     }
     let md = std::fs::read_to_string(dir.path().join("b/zioma-t6-1.md")).unwrap();
     assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 2 + 3, "{md}");
@@ -695,6 +717,11 @@ fn bench_quick_writes_complete_tables() {
         if gpu {
             let clock = r["gpu"]["clock"].as_str().unwrap();
             assert!(clock == "wall clock" || clock == "timestamp queries", "{clock}");
+            // One dispatch per update, a sample's updates in one submission.
+            let commands = &r["gpu_commands"];
+            assert_eq!(commands["dispatches"].as_f64(), Some(1.0), "{commands}");
+            assert_eq!(commands["bind_groups"].as_f64(), Some(0.0), "{commands}");
+            assert!(commands["submissions"].as_f64().unwrap() < 0.1, "{commands}");
         }
     }
     let md = std::fs::read_to_string(dir.path().join("b/skjermo.md")).unwrap();

@@ -112,7 +112,7 @@ fn fk_table(ctx: Option<&'static GpuContext>) {
             for _ in 0..poses {
                 p.record(c, &mut e);
             }
-            c.queue.submit([e.finish()]);
+            c.submit([e.finish()]);
             c.wait().unwrap();
         });
         d.as_secs_f64() * 1e3 / poses as f64

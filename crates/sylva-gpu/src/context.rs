@@ -1,5 +1,6 @@
 //! The GPU context: instance, adapter, device and queue.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
 
 /// Errors setting up or using the GPU.
@@ -55,6 +56,50 @@ impl std::fmt::Display for AdapterSummary {
     }
 }
 
+/// The commands Sylva's kernels recorded and submitted on a context, counted as they are
+/// made ([`GpuContext::counts`]): the work model of `sylva bench` divides a run's difference
+/// by its steps. Each dispatch, compute pass and bind group costs the driver time on the CPU
+/// and, between dependent dispatches, a barrier on the GPU; each submission a trip through
+/// the queue.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct GpuCounts {
+    /// Compute dispatches recorded.
+    pub dispatches: u64,
+    /// Compute passes begun.
+    pub passes: u64,
+    /// Bind groups created for compute kernels.
+    pub bind_groups: u64,
+    /// Command submissions to the queue.
+    pub submissions: u64,
+}
+
+impl std::ops::Sub for GpuCounts {
+    type Output = GpuCounts;
+    fn sub(self, rhs: Self) -> Self {
+        Self {
+            dispatches: self.dispatches - rhs.dispatches,
+            passes: self.passes - rhs.passes,
+            bind_groups: self.bind_groups - rhs.bind_groups,
+            submissions: self.submissions - rhs.submissions,
+        }
+    }
+}
+
+/// The running totals behind [`GpuCounts`].
+#[derive(Debug, Default)]
+pub(crate) struct Counters {
+    pub(crate) dispatches: AtomicU64,
+    pub(crate) passes: AtomicU64,
+    pub(crate) bind_groups: AtomicU64,
+    submissions: AtomicU64,
+}
+
+impl Counters {
+    pub(crate) fn add(counter: &AtomicU64) {
+        counter.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
 /// A device and its queue, with the adapter it came from.
 #[derive(Debug)]
 pub struct GpuContext {
@@ -75,6 +120,7 @@ pub struct GpuContext {
     /// [`crate::kernel::Kernel::cached`]).
     pub(crate) kernels:
         std::sync::Mutex<std::collections::HashMap<&'static str, std::sync::Arc<crate::kernel::Kernel>>>,
+    pub(crate) counters: Counters,
 }
 
 impl GpuContext {
@@ -115,7 +161,16 @@ impl GpuContext {
             trace: wgpu::Trace::Off,
         }))
         .map_err(|e| GpuError::Device { adapter: summary.name.clone(), message: e.to_string() })?;
-        Ok(Self { instance: Some(instance), adapter, device, queue, summary, timestamps, kernels: Default::default() })
+        Ok(Self {
+            instance: Some(instance),
+            adapter,
+            device,
+            queue,
+            summary,
+            timestamps,
+            kernels: Default::default(),
+            counters: Default::default(),
+        })
     }
 
     /// A context on an application's own device, so an engine and Sylva share it. Kernels
@@ -136,7 +191,16 @@ impl GpuContext {
             driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
         };
         let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        Self { instance, adapter, device, queue, summary, timestamps, kernels: Default::default() }
+        Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            summary,
+            timestamps,
+            kernels: Default::default(),
+            counters: Default::default(),
+        }
     }
 
     /// One context shared by the whole process (tests, benchmarks, the CLI): created on
@@ -155,6 +219,23 @@ impl GpuContext {
         match SHARED.get_or_init(|| GpuContext::new(&GpuOptions::default()).map(Arc::new).map_err(|e| e.to_string())) {
             Ok(c) => Ok(c),
             Err(e) => Err(GpuError::Unavailable(e.clone())),
+        }
+    }
+
+    /// Submits command buffers to the queue, counted in [`Self::counts`].
+    pub fn submit<I: IntoIterator<Item = wgpu::CommandBuffer>>(&self, commands: I) -> wgpu::SubmissionIndex {
+        Counters::add(&self.counters.submissions);
+        self.queue.submit(commands)
+    }
+
+    /// The commands recorded and submitted on this context so far, by every user of it.
+    pub fn counts(&self) -> GpuCounts {
+        let c = &self.counters;
+        GpuCounts {
+            dispatches: c.dispatches.load(Ordering::Relaxed),
+            passes: c.passes.load(Ordering::Relaxed),
+            bind_groups: c.bind_groups.load(Ordering::Relaxed),
+            submissions: c.submissions.load(Ordering::Relaxed),
         }
     }
 

@@ -5,6 +5,7 @@
 //! Kernels index their work item as `gid.x + gid.y * num_workgroups.x * WORKGROUP`, so a
 //! dispatch larger than the 65,535-workgroup limit of one dimension spills into `y`.
 
+use crate::context::Counters;
 use crate::{GpuContext, GpuError};
 use bytemuck::Pod;
 use wgpu::util::DeviceExt;
@@ -80,7 +81,25 @@ impl Kernel {
         self
     }
 
-    /// Records a dispatch of `invocations` work items with `buffers` bound at 0, 1, 2, …
+    /// Binds `buffers` at 0, 1, 2, … for this kernel, once, for dispatches recorded many
+    /// times ([`Self::record_bound`], [`Self::dispatch`]): creating a bind group is most of
+    /// what recording a small dispatch costs the CPU.
+    pub fn bind(&self, ctx: &GpuContext, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
+        let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+            .collect();
+        Counters::add(&ctx.counters.bind_groups);
+        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(self.name),
+            layout: &self.layout,
+            entries: &entries,
+        })
+    }
+
+    /// Records a dispatch of `invocations` work items with `buffers` bound at 0, 1, 2, …, in
+    /// a pass of its own.
     pub fn record(
         &self,
         ctx: &GpuContext,
@@ -88,24 +107,40 @@ impl Kernel {
         buffers: &[&wgpu::Buffer],
         invocations: u32,
     ) {
-        let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-            .collect();
-        let bind = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(self.name),
-            layout: &self.layout,
-            entries: &entries,
-        });
+        let bind = self.bind(ctx, buffers);
+        self.record_bound(ctx, encoder, &bind, invocations);
+    }
+
+    /// Records a dispatch of `invocations` work items on a bind group from [`Self::bind`], in
+    /// a pass of its own.
+    pub fn record_bound(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        bind: &wgpu::BindGroup,
+        invocations: u32,
+    ) {
+        let mut pass = compute_pass(ctx, encoder, self.name);
+        self.dispatch(ctx, &mut pass, bind, invocations);
+    }
+
+    /// Records a dispatch of `invocations` work items on a bind group from [`Self::bind`]
+    /// into an open pass ([`compute_pass`]): dependent dispatches of one pass are ordered
+    /// by the barriers wgpu inserts between them.
+    pub fn dispatch(
+        &self,
+        ctx: &GpuContext,
+        pass: &mut wgpu::ComputePass<'_>,
+        bind: &wgpu::BindGroup,
+        invocations: u32,
+    ) {
         let groups = invocations.div_ceil(WORKGROUP).max(1);
         let device_max = ctx.device.limits().max_compute_workgroups_per_dimension.max(1);
         let max = self.max_groups_x.map_or(device_max, |m| m.min(device_max));
         let (x, y) = if groups <= max { (groups, 1) } else { (max, groups.div_ceil(max)) };
-        let mut pass =
-            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: None });
+        Counters::add(&ctx.counters.dispatches);
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind, &[]);
+        pass.set_bind_group(0, bind, &[]);
         pass.dispatch_workgroups(x, y, 1);
     }
 
@@ -129,7 +164,7 @@ impl Kernel {
         }
         ctx.wait()?;
         let start = std::time::Instant::now();
-        ctx.queue.submit([encoder.finish()]);
+        ctx.submit([encoder.finish()]);
         ctx.wait()?;
         let wall = start.elapsed();
         let gpu = match &timer {
@@ -143,8 +178,88 @@ impl Kernel {
     pub fn run(&self, ctx: &GpuContext, buffers: &[&wgpu::Buffer], invocations: u32) {
         let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(self.name) });
         self.record(ctx, &mut encoder, buffers, invocations);
-        ctx.queue.submit([encoder.finish()]);
+        ctx.submit([encoder.finish()]);
     }
+}
+
+/// Dispatches bound once and recorded together: each entry a kernel, its bind group and its
+/// invocations, recorded in order into one compute pass (the barriers between dispatches
+/// order those that depend on each other). For work whose buffers do not change from frame
+/// to frame, such as a pose's forward kinematics.
+#[derive(Debug, Default)]
+pub struct Plan(Vec<(std::sync::Arc<Kernel>, wgpu::BindGroup, u32)>);
+
+impl Plan {
+    /// Appends a dispatch of `kernel` over `invocations` with `buffers` bound at 0, 1, 2, …
+    pub fn push(
+        &mut self,
+        ctx: &GpuContext,
+        kernel: &std::sync::Arc<Kernel>,
+        buffers: &[&wgpu::Buffer],
+        invocations: u32,
+    ) {
+        self.0.push((kernel.clone(), kernel.bind(ctx, buffers), invocations));
+    }
+
+    /// Records every dispatch, in order, in one pass labelled `label` (none when empty).
+    pub fn record(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, label: &'static str) {
+        if self.0.is_empty() {
+            return;
+        }
+        let mut pass = compute_pass(ctx, encoder, label);
+        self.dispatch(ctx, &mut pass);
+    }
+
+    /// Records every dispatch, in order, into an open pass.
+    pub fn dispatch(&self, ctx: &GpuContext, pass: &mut wgpu::ComputePass<'_>) {
+        for (kernel, bind, invocations) in &self.0 {
+            kernel.dispatch(ctx, pass, bind, *invocations);
+        }
+    }
+
+    /// The dispatches recorded by [`Self::record`].
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// Whether there is nothing to record.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
+/// A [`Plan`] for the buffers it was last asked for, made again when they change: for
+/// kernels that read a method's or an application's buffers, the same ones frame after
+/// frame. It keeps those buffers alive until it is dropped or asked for others.
+#[derive(Debug, Default)]
+pub struct PlanCache(std::sync::Mutex<Option<(Vec<wgpu::Buffer>, std::sync::Arc<Plan>)>>);
+
+impl PlanCache {
+    /// The plan for `buffers`, made by `make` unless the last call passed the same ones.
+    pub fn get(&self, buffers: &[&wgpu::Buffer], make: impl FnOnce() -> Plan) -> std::sync::Arc<Plan> {
+        let mut cache = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        match &*cache {
+            Some((key, plan)) if key.len() == buffers.len() && key.iter().zip(buffers).all(|(a, b)| a == *b) => {
+                plan.clone()
+            }
+            _ => {
+                let plan = std::sync::Arc::new(make());
+                *cache = Some((buffers.iter().map(|b| (*b).clone()).collect(), plan.clone()));
+                plan
+            }
+        }
+    }
+}
+
+/// Begins a compute pass (counted in [`GpuContext::counts`]) for dispatches recorded with
+/// [`Kernel::dispatch`].
+pub fn compute_pass<'e>(
+    ctx: &GpuContext,
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &'static str,
+) -> wgpu::ComputePass<'e> {
+    Counters::add(&ctx.counters.passes);
+    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None })
 }
 
 fn check_size(ctx: &GpuContext, what: &'static str, bytes: u64) -> Result<(), GpuError> {
@@ -200,7 +315,7 @@ pub fn read_back<T: Pod>(ctx: &GpuContext, buffer: &wgpu::Buffer, len: usize) ->
     });
     let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
-    ctx.queue.submit([encoder.finish()]);
+    ctx.submit([encoder.finish()]);
     map_read(ctx, &staging, |bytes| bytemuck::cast_slice::<u8, T>(bytes).to_vec())
 }
 

@@ -28,5 +28,5 @@ pub mod shaders;
 pub mod timer;
 pub mod wind;
 
-pub use context::{AdapterSummary, GpuContext, GpuError, GpuOptions};
+pub use context::{AdapterSummary, GpuContext, GpuCounts, GpuError, GpuOptions};
 pub use sylva_core;

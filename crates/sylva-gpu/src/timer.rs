@@ -81,7 +81,7 @@ impl GpuTimer {
     pub fn start(&self, ctx: &GpuContext) {
         let mut e = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("timer start") });
         self.begin(&mut e);
-        ctx.queue.submit([e.finish()]);
+        ctx.submit([e.finish()]);
     }
 
     /// Submits the second timestamp on its own, after everything submitted since
@@ -89,7 +89,7 @@ impl GpuTimer {
     pub fn stop(&self, ctx: &GpuContext) {
         let mut e = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("timer stop") });
         self.end(&mut e);
-        ctx.queue.submit([e.finish()]);
+        ctx.submit([e.finish()]);
     }
 
     /// Waits for the GPU and returns the time between the two stamps; `None` when the

@@ -142,7 +142,7 @@ fn pointer_jumping_matches_on_a_deep_stem() {
     ctx.queue.write_buffer(pose.delta_buffer(), 0, bytemuck::cast_slice(&delta));
     let mut e = ctx.device.create_command_encoder(&Default::default());
     pose.record(ctx, &mut e);
-    ctx.queue.submit([e.finish()]);
+    ctx.submit([e.finish()]);
     let gpu_acc: Vec<[f32; 4]> = read_back(ctx, pose.acc_buffer(), n * instances).unwrap();
     let gpu_joints: Vec<[f32; 4]> = read_back(ctx, pose.joints_buffer(), n * instances).unwrap();
     let parent = &t.segments.parent;
@@ -177,7 +177,7 @@ fn pointer_jumping_matches_on_a_deep_stem() {
     ctx.queue.write_buffer(pose.acc_buffer(), 0, bytemuck::cast_slice(&one_acc));
     let mut e = ctx.device.create_command_encoder(&Default::default());
     pose.record_positions(ctx, &mut e);
-    ctx.queue.submit([e.finish()]);
+    ctx.submit([e.finish()]);
     let gpu_joints: Vec<[f32; 4]> = read_back(ctx, pose.joints_buffer(), total).unwrap();
     let mut terms = vec![[0.0f32; 4]; total];
     pose_jump_terms(parent, &rest, &one_acc, &mut terms);

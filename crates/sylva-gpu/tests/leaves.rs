@@ -79,7 +79,7 @@ fn leaf_kernels_match_the_cpu() {
             let out = upload(ctx, "leaf", &vec![[0.0f32; 4]; t.leaves.len()]).unwrap();
             let mut e = ctx.device.create_command_encoder(&Default::default());
             gpu.record(ctx, &mut e, &gw, [&joints, &acc, &out], time);
-            ctx.queue.submit([e.finish()]);
+            ctx.submit([e.finish()]);
             let got: Vec<[f32; 4]> = read_back(ctx, &out, t.leaves.len()).unwrap();
             let moved = seam.leaf.iter().filter(|q| angle_between(**q, [0.0, 0.0, 0.0, 1.0]) > 0.01).count();
             assert!(2 * moved > t.leaves.len(), "{species}: only {moved} of {} leaves turned", t.leaves.len());
@@ -155,7 +155,7 @@ fn hsm_leaf_pose_matches_the_cpu() {
     let kernel = sylva_gpu::kernel::Kernel::get(ctx, "hsm_leaf_pose");
     let mut e = ctx.device.create_command_encoder(&Default::default());
     kernel.record(ctx, &mut e, &buffers.iter().collect::<Vec<_>>(), leaves as u32);
-    ctx.queue.submit([e.finish()]);
+    ctx.submit([e.finish()]);
     let gpu: Vec<[f32; 4]> = read_back(ctx, &buffers[5], leaves).unwrap();
     let mut worst = 0.0f32;
     for l in 0..leaves {
@@ -201,7 +201,7 @@ fn meshed_leaves_follow_their_rotations_on_both() {
     let cpu = layout.mesh_seam(&seam.joints, &seam.acc, &seam.leaf);
     let mut e = ctx.device.create_command_encoder(&Default::default());
     mesh.record_seam(ctx, &mut e, &seam);
-    ctx.queue.submit([e.finish()]);
+    ctx.submit([e.finish()]);
     let gpu = mesh.read(ctx).unwrap();
     let h = t.height();
     let stride = layout.params.leaf_sides as usize + 1;
@@ -261,7 +261,7 @@ fn skinned_leaves_follow_their_rotations() {
         (upload(ctx, "j", &joint).unwrap(), upload(ctx, "a", &acc).unwrap(), upload(ctx, "l", &seam.leaf).unwrap());
     let mut e = ctx.device.create_command_encoder(&Default::default());
     g.record_with_leaves(ctx, &mut e, &jb, &ab, &lb);
-    ctx.queue.submit([e.finish()]);
+    ctx.submit([e.finish()]);
     let gpu = g.read(ctx).unwrap();
     for (k, (a, b)) in gpu.leaves.iter().zip(&cpu.leaves).enumerate() {
         let d = (Vec3::from_array(a.position) - Vec3::from_array(b.position)).length();

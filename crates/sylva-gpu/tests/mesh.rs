@@ -110,7 +110,7 @@ fn gpu_mesh_reads_a_gpu_methods_pose_without_a_round_trip() {
         g.submit(ctx, time);
         let mut e = ctx.device.create_command_encoder(&Default::default());
         mesh.record(ctx, &mut e, g.pose_buffers().joints_buffer(), g.pose_buffers().acc_buffer());
-        ctx.queue.submit([e.finish()]);
+        ctx.submit([e.finish()]);
         let on_gpu = mesh.read(ctx).unwrap();
         let pose = g.pose_buffers().read(ctx).unwrap();
         let worst = compare(&t, &layout.mesh(&t, &pose), &on_gpu, &format!("zioma t = {time}"));
@@ -148,7 +148,7 @@ fn gpu_skinning_matches_cpu_for_many_instances() {
         assert_eq!(g.draw_items(&jb).iter().map(|d| d.instance_count).sum::<u32>(), instances);
         let mut e = ctx.device.create_command_encoder(&Default::default());
         g.record(ctx, &mut e, &jb, &ab);
-        ctx.queue.submit([e.finish()]);
+        ctx.submit([e.finish()]);
         let gpu = g.read(ctx).unwrap();
         let worst = compare(&t, &cpu, &gpu, "skinning");
         println!("skinning {instances} aspens in {batches} batch(es): worst {worst:.1e} × height");

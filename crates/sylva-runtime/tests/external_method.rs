@@ -253,7 +253,7 @@ impl GpuAnimator for GpuRigid {
                 n,
             );
             self.pose.record(ctx, &mut e);
-            ctx.queue.submit([e.finish()]);
+            ctx.submit([e.finish()]);
         }
     }
     fn time(&self) -> f32 {
@@ -308,7 +308,7 @@ fn a_method_defined_outside_sylva_runs_through_the_runtime_on_cpu_and_gpu() {
         world.step(60).unwrap();
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         world.record(&mut encoder);
-        ctx.queue.submit([encoder.finish()]);
+        ctx.submit([encoder.finish()]);
         assert_eq!(world.draw_items().len(), 2, "{backend}: two phase groups, a mesh each");
         let pose = world.trees()[0].pose(&ctx).unwrap();
         let t = &world.trees()[0].tree;

@@ -244,7 +244,7 @@ impl App {
         if let Some((t, _)) = &self.timers {
             t.start(ctx);
         }
-        ctx.queue.submit([encoder.finish()]);
+        ctx.submit([encoder.finish()]);
         if let Some((t, _)) = &self.timers {
             t.stop(ctx);
         }
@@ -386,11 +386,11 @@ impl App {
                     });
                     gfx.painter.render(&mut pass.forget_lifetime(), &prims, &screen);
                 }
-                ctx.queue.submit(extra.into_iter().chain([encoder.finish()]));
+                ctx.submit(extra.into_iter().chain([encoder.finish()]));
                 ctx.queue.present(frame);
             }
             None => {
-                ctx.queue.submit([encoder.finish()]);
+                ctx.submit([encoder.finish()]);
             }
         }
         for id in &textures.free {

@@ -2,7 +2,7 @@
 //! every twig, `leaf_flutter.wgsl` turns every leaf about its attachment from it, reading
 //! the seam's rotations and writing the seam's leaf rotations ([`crate::pose::GpuPose`]).
 
-use crate::kernel::{Kernel, output, upload};
+use crate::kernel::{Kernel, Plan, PlanCache, output, upload};
 use crate::pose::GpuPose;
 use crate::wind::GpuWind;
 use crate::{GpuContext, GpuError};
@@ -19,6 +19,8 @@ pub struct GpuLeafFlutter {
     motion: wgpu::Buffer,
     twigs: wgpu::Buffer,
     twig_wind: wgpu::Buffer,
+    /// Both kernels bound to the last wind and seam buffers.
+    plan: PlanCache,
 }
 
 impl GpuLeafFlutter {
@@ -32,6 +34,7 @@ impl GpuLeafFlutter {
             twigs: upload(ctx, "leaf twigs", &leaves.twigs)?,
             twig_wind: output::<[f32; 4]>(ctx, "twig wind", 2 * leaves.twigs.len())?,
             leaves: leaves.clone(),
+            plan: Default::default(),
         })
     }
 
@@ -63,17 +66,14 @@ impl GpuLeafFlutter {
         }
         let frame: RawLeafFrame = self.leaves.frame(t);
         ctx.queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame));
-        self.wind_kernel.record(
-            ctx,
-            encoder,
-            &[&wind.fields, &wind.waves, &self.frame, &self.twigs, joints, &self.twig_wind],
-            self.leaves.twigs.len() as u32,
-        );
-        self.flutter_kernel.record(
-            ctx,
-            encoder,
-            &[&self.frame, &self.motion, &self.twig_wind, acc, out],
-            self.leaves.leaves.len() as u32,
-        );
+        let plan = self.plan.get(&[&wind.fields, &wind.waves, joints, acc, out], || {
+            let mut plan = Plan::default();
+            let buffers = [&wind.fields, &wind.waves, &self.frame, &self.twigs, joints, &self.twig_wind];
+            plan.push(ctx, &self.wind_kernel, &buffers, self.leaves.twigs.len() as u32);
+            let buffers = [&self.frame, &self.motion, &self.twig_wind, acc, out];
+            plan.push(ctx, &self.flutter_kernel, &buffers, self.leaves.leaves.len() as u32);
+            plan
+        });
+        plan.record(ctx, encoder, "leaves");
     }
 }

@@ -86,7 +86,7 @@ impl GpuDeform {
     pub fn deform(&self, ctx: &GpuContext, state: &[RawSkjermoState]) -> Result<Vec<RawVertex>, GpuError> {
         let mut e = ctx.device.create_command_encoder(&Default::default());
         self.record_state(ctx, &mut e, state);
-        ctx.queue.submit([e.finish()]);
+        ctx.submit([e.finish()]);
         read_back(ctx, &self.vertices, self.vertex_count)
     }
 

@@ -8,7 +8,7 @@
 pub mod deform;
 pub mod skin;
 
-use crate::kernel::{Kernel, output, read_back, upload};
+use crate::kernel::{Kernel, Plan, PlanCache, output, read_back, upload};
 use crate::{GpuContext, GpuError};
 use std::sync::Arc;
 use sylva_core::Tree;
@@ -52,6 +52,9 @@ pub struct GpuMesh {
     leaf_count: usize,
     segment_count: usize,
     leaf_slots: usize,
+    /// The kernels bound to the last pose buffers meshed (a method's are the same every
+    /// frame).
+    plan: PlanCache,
 }
 
 pub(crate) fn vertex_buffer(ctx: &GpuContext, label: &'static str, len: usize) -> Result<wgpu::Buffer, GpuError> {
@@ -113,6 +116,7 @@ impl GpuMesh {
             leaf_count: layout.leaves.len(),
             segment_count: n,
             leaf_slots: layout.leaf_slots as usize,
+            plan: Default::default(),
         })
     }
 
@@ -139,30 +143,26 @@ impl GpuMesh {
         acc: &wgpu::Buffer,
         leaf_rotation: &wgpu::Buffer,
     ) {
-        if self.ring_count > 0 {
-            self.tubes.record(
-                ctx,
-                encoder,
-                &[&self.info, &self.rings, &self.segments, joint, acc, &self.tube_vertices],
-                self.ring_count as u32,
-            );
-        }
-        if self.detail_count > 0 {
-            self.detail_kernel.record(
-                ctx,
-                encoder,
-                &[&self.info, &self.details, &self.tube_vertices],
-                self.detail_count as u32,
-            );
-        }
-        if self.leaf_count > 0 {
-            self.leaves_kernel.record(
-                ctx,
-                encoder,
-                &[&self.info, &self.leaves, &self.segments, joint, acc, &self.leaf_vertices, leaf_rotation],
-                self.leaf_count as u32,
-            );
-        }
+        let plan = self.plan.get(&[joint, acc, leaf_rotation], || {
+            // One pass: the detail kernel reads the rings' vertices the tube kernel wrote,
+            // which the barrier between dispatches orders.
+            let mut plan = Plan::default();
+            if self.ring_count > 0 {
+                let buffers = [&self.info, &self.rings, &self.segments, joint, acc, &self.tube_vertices];
+                plan.push(ctx, &self.tubes, &buffers, self.ring_count as u32);
+            }
+            if self.detail_count > 0 {
+                let buffers = [&self.info, &self.details, &self.tube_vertices];
+                plan.push(ctx, &self.detail_kernel, &buffers, self.detail_count as u32);
+            }
+            if self.leaf_count > 0 {
+                let buffers =
+                    [&self.info, &self.leaves, &self.segments, joint, acc, &self.leaf_vertices, leaf_rotation];
+                plan.push(ctx, &self.leaves_kernel, &buffers, self.leaf_count as u32);
+            }
+            plan
+        });
+        plan.record(ctx, encoder, "mesh");
     }
 
     /// Uploads a CPU pose and records the vertex kernels on it.
@@ -196,7 +196,7 @@ impl GpuMesh {
     pub fn mesh(&self, ctx: &GpuContext, tree: &Tree, pose: &Pose) -> Result<MeshFrame, GpuError> {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         self.record_pose(ctx, &mut encoder, tree, pose);
-        ctx.queue.submit([encoder.finish()]);
+        ctx.submit([encoder.finish()]);
         self.read(ctx)
     }
 

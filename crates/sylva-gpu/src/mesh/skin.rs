@@ -1,7 +1,7 @@
 //! Skinning on the GPU (Zioma §6.5): one rest mesh, every instance's pose applied by
 //! `skin_vertices.wgsl` into instance-major vertex buffers the renderer draws as they are.
 
-use crate::kernel::{Kernel, read_back, upload};
+use crate::kernel::{Kernel, Plan, PlanCache, read_back, upload};
 use crate::mesh::{index_buffer, vertex_buffer};
 use crate::render::{DrawItem, MeshBuffers};
 use crate::{GpuContext, GpuError};
@@ -51,6 +51,8 @@ pub struct GpuSkin {
     leaves: Part,
     batches: Vec<Batch>,
     instances: u32,
+    /// The batches bound to the last pose buffers skinned.
+    plan: PlanCache,
 }
 
 impl GpuSkin {
@@ -116,6 +118,7 @@ impl GpuSkin {
             leaves,
             batches,
             instances,
+            plan: Default::default(),
         })
     }
 
@@ -146,18 +149,29 @@ impl GpuSkin {
         acc: &wgpu::Buffer,
         leaf_rotation: &wgpu::Buffer,
     ) {
-        for b in &self.batches {
-            for (p, (info, out)) in [&self.tubes, &self.leaves].into_iter().zip(&b.out) {
-                if p.vertices > 0 {
-                    self.kernel.record(
-                        ctx,
-                        encoder,
-                        &[info, &p.rest, &p.skin, &self.rest_joint, joint, acc, out, &self.leaf_attach, leaf_rotation],
-                        (p.vertices * b.count as usize) as u32,
-                    );
+        let plan = self.plan.get(&[joint, acc, leaf_rotation], || {
+            let mut plan = Plan::default();
+            for b in &self.batches {
+                for (p, (info, out)) in [&self.tubes, &self.leaves].into_iter().zip(&b.out) {
+                    if p.vertices > 0 {
+                        let buffers = [
+                            info,
+                            &p.rest,
+                            &p.skin,
+                            &self.rest_joint,
+                            joint,
+                            acc,
+                            out,
+                            &self.leaf_attach,
+                            leaf_rotation,
+                        ];
+                        plan.push(ctx, &self.kernel, &buffers, (p.vertices * b.count as usize) as u32);
+                    }
                 }
             }
-        }
+            plan
+        });
+        plan.record(ctx, encoder, "skin");
     }
 
     /// Reads every instance's vertices back (instance-major).

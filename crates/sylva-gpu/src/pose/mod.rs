@@ -3,7 +3,7 @@
 
 pub mod segment_ends;
 
-use crate::kernel::{Kernel, output, read_back, upload};
+use crate::kernel::{Kernel, Plan, compute_pass, output, read_back, upload};
 use crate::{GpuContext, GpuError};
 use glam::{Quat, Vec3};
 use std::sync::Arc;
@@ -95,6 +95,10 @@ pub struct GpuPose {
     n: usize,
     instances: usize,
     rest_orientation: Vec<Quat>,
+    /// The dispatches from δ to the accumulated rotations, then from those to the joints,
+    /// bound once.
+    rotations_plan: Plan,
+    positions_plan: Plan,
 }
 
 impl GpuPose {
@@ -141,7 +145,7 @@ impl GpuPose {
             _ => Vec::new(),
         };
         let rest: Vec<[f32; 4]> = tree.segments.start.iter().map(|p| p.extend(0.0).to_array()).collect();
-        Ok(Self {
+        let mut this = Self {
             accumulate: Kernel::get(ctx, "pose_accumulate"),
             positions: Kernel::get(ctx, "pose_positions"),
             level: Kernel::get(ctx, "pose_level"),
@@ -170,7 +174,56 @@ impl GpuPose {
             n,
             instances,
             rest_orientation: tree.segments.orientation.clone(),
-        })
+            rotations_plan: Plan::default(),
+            positions_plan: Plan::default(),
+        };
+        this.plan(ctx);
+        Ok(this)
+    }
+
+    /// Binds the strategy's dispatches once: δ to accumulated rotations, then to joints.
+    fn plan(&mut self, ctx: &GpuContext) {
+        let total = (self.n * self.instances) as u32;
+        let (mut rotations, mut positions) = (Plan::default(), Plan::default());
+        match self.strategy {
+            FkStrategy::AncestorWalk => {
+                rotations.push(ctx, &self.accumulate, &[&self.parents, &self.delta, &self.acc], total);
+                positions.push(ctx, &self.positions, &[&self.parents, &self.rest, &self.acc, &self.joints], total);
+            }
+            FkStrategy::LevelByLevel => {
+                // Each level writes rotations and joints together.
+                for (bucket, len) in &self.levels {
+                    rotations.push(
+                        ctx,
+                        &self.level,
+                        &[bucket, &self.parents, &self.rest, &self.delta, &self.acc, &self.disp, &self.joints],
+                        *len,
+                    );
+                }
+                positions.push(ctx, &self.positions, &[&self.parents, &self.rest, &self.acc, &self.joints], total);
+            }
+            FkStrategy::PointerJump => {
+                // Rounds alternate between acc and scratch so that the last one writes acc
+                // (with no rounds, `record` copies δ into acc).
+                let rounds = self.jumps.len();
+                let mut input = &self.delta;
+                for (k, anc) in self.jumps.iter().enumerate() {
+                    let out = if (rounds - 1 - k) % 2 == 0 { &self.acc } else { &self.scratch };
+                    rotations.push(ctx, &self.jump[0], &[anc, input, out], total);
+                    input = out;
+                }
+                // The joints from acc: the terms, the rounds of sums alternating between
+                // joints and scratch so that the last one writes scratch, then rest + sum.
+                let ping = |k: usize| if (rounds - k) % 2 == 0 { &self.scratch } else { &self.joints };
+                positions.push(ctx, &self.jump[1], &[&self.parents, &self.rest, &self.acc, ping(0)], total);
+                for (k, anc) in self.jumps.iter().enumerate() {
+                    positions.push(ctx, &self.jump[2], &[anc, ping(k), ping(k + 1)], total);
+                }
+                positions.push(ctx, &self.jump[3], &[&self.rest, &self.scratch, &self.joints], total);
+            }
+        }
+        self.rotations_plan = rotations;
+        self.positions_plan = positions;
     }
 
     /// The first instance's leaf rotations (`λ` of [`sylva_core::pose::SeamPose::leaf`]; the
@@ -195,37 +248,17 @@ impl GpuPose {
     }
 
     /// Runs forward kinematics on the rotations in [`Self::delta_buffer`] (recorded into
-    /// `encoder`).
+    /// `encoder`, one compute pass).
     pub fn record(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
-        let total = (self.n * self.instances) as u32;
         match self.strategy {
-            FkStrategy::AncestorWalk => {
-                self.accumulate.record(ctx, encoder, &[&self.parents, &self.delta, &self.acc], total);
-                self.positions.record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, &self.joints], total);
-            }
-            FkStrategy::LevelByLevel => {
-                for (bucket, len) in &self.levels {
-                    self.level.record(
-                        ctx,
-                        encoder,
-                        &[bucket, &self.parents, &self.rest, &self.delta, &self.acc, &self.disp, &self.joints],
-                        *len,
-                    );
-                }
-            }
-            FkStrategy::PointerJump => {
-                // Rounds alternate between acc and scratch so that the last one writes acc.
-                let rounds = self.jumps.len();
-                if rounds == 0 {
+            FkStrategy::LevelByLevel => self.rotations_plan.record(ctx, encoder, "forward kinematics"),
+            _ => {
+                if self.strategy == FkStrategy::PointerJump && self.jumps.is_empty() {
                     encoder.copy_buffer_to_buffer(&self.delta, 0, &self.acc, 0, self.acc.size());
                 }
-                let mut input = &self.delta;
-                for (k, anc) in self.jumps.iter().enumerate() {
-                    let out = if (rounds - 1 - k) % 2 == 0 { &self.acc } else { &self.scratch };
-                    self.jump[0].record(ctx, encoder, &[anc, input, out], total);
-                    input = out;
-                }
-                self.record_jump_positions(ctx, encoder);
+                let mut pass = compute_pass(ctx, encoder, "forward kinematics");
+                self.rotations_plan.dispatch(ctx, &mut pass);
+                self.positions_plan.dispatch(ctx, &mut pass);
             }
         }
     }
@@ -234,26 +267,12 @@ impl GpuPose {
     /// [`Self::acc_buffer`] (methods whose rotations are already world rotations, as HSM's
     /// cluster R).
     pub fn record_positions(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
-        match self.strategy {
-            FkStrategy::PointerJump => self.record_jump_positions(ctx, encoder),
-            _ => {
-                let total = (self.n * self.instances) as u32;
-                self.positions.record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, &self.joints], total);
-            }
-        }
+        self.positions_plan.record(ctx, encoder, "joint positions");
     }
 
-    /// Pointer jumping's joints from acc: the terms, the rounds of sums alternating between
-    /// joints and scratch so that the last one writes scratch, then rest + sum into joints.
-    fn record_jump_positions(&self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
-        let total = (self.n * self.instances) as u32;
-        let rounds = self.jumps.len();
-        let ping = |k: usize| if (rounds - k) % 2 == 0 { &self.scratch } else { &self.joints };
-        self.jump[1].record(ctx, encoder, &[&self.parents, &self.rest, &self.acc, ping(0)], total);
-        for (k, anc) in self.jumps.iter().enumerate() {
-            self.jump[2].record(ctx, encoder, &[anc, ping(k), ping(k + 1)], total);
-        }
-        self.jump[3].record(ctx, encoder, &[&self.rest, &self.scratch, &self.joints], total);
+    /// [`Self::record_positions`] into an open pass, after the dispatches that write acc.
+    pub fn dispatch_positions(&self, ctx: &GpuContext, pass: &mut wgpu::ComputePass<'_>) {
+        self.positions_plan.dispatch(ctx, pass);
     }
 
     /// The buffer of posed joint positions (w = 0), instance-major.
@@ -296,7 +315,7 @@ impl GpuPose {
         ctx.queue.write_buffer(&self.delta, 0, bytemuck::cast_slice(delta));
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         self.record(ctx, &mut encoder);
-        ctx.queue.submit([encoder.finish()]);
+        ctx.submit([encoder.finish()]);
         self.read(ctx)
     }
 

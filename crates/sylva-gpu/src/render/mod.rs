@@ -635,7 +635,7 @@ impl Renderer {
             },
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
-        ctx.queue.submit([encoder.finish()]);
+        ctx.submit([encoder.finish()]);
         crate::kernel::map_read(ctx, &self.readback, |bytes| {
             let mut out = Vec::with_capacity((w * h * 4) as usize);
             for row in bytes.chunks(self.padded_row as usize).take(h as usize) {

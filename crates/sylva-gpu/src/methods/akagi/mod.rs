@@ -105,7 +105,7 @@ impl GpuAkagi {
         );
         self.pose.record(ctx, &mut e);
         self.leaves.record_pose(ctx, &mut e, &self.wind, &self.pose, self.time);
-        ctx.queue.submit([e.finish()]);
+        ctx.submit([e.finish()]);
     }
 }
 

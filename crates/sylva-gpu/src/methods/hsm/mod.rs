@@ -8,10 +8,11 @@
 //! `hsm_goals` and stage 4 `hsm_integrate` run one invocation per particle, or fused as
 //! `hsm_particles` ([`sylva_core::methods::hsm::HsmParams::fused`]). Each substep's
 //! parameters (its time) are copied into the step buffer by a copy command between
-//! substeps, so one submission carries every substep.
+//! substeps, so one submission carries every substep; a substep's dispatches share one
+//! compute pass and bind groups made once.
 
 use super::{BuildError, GpuAnimator};
-use crate::kernel::{Kernel, output, upload};
+use crate::kernel::{Kernel, Plan, compute_pass, output, upload};
 use crate::pose::GpuPose;
 use crate::wind::GpuWind;
 use crate::{GpuContext, GpuError};
@@ -54,6 +55,12 @@ pub struct GpuHsm {
     goal: wgpu::Buffer,
     n_clusters: usize,
     n_particles: usize,
+    /// The pose's dispatches, bound once: segment rotations, then leaf rotations.
+    pose_plan: Plan,
+    leaf_plan: Plan,
+    /// A substep's dispatches (stage 1, then the fused particle pass or stages 3 and 4),
+    /// bound on first use after the wind is set.
+    substep: Option<Plan>,
     /// Simulated time, s.
     pub time: f32,
 }
@@ -78,7 +85,7 @@ impl GpuHsm {
             None => None,
         };
         let step = method.step_params(0.0, 0.0);
-        let this = Self {
+        let mut this = Self {
             clusters_kernel: Kernel::get(ctx, "hsm_clusters"),
             goals_kernel: Kernel::get(ctx, "hsm_goals"),
             integrate_kernel: Kernel::get(ctx, "hsm_integrate"),
@@ -105,15 +112,19 @@ impl GpuHsm {
             goal: output::<[f32; 4]>(ctx, "hsm goals", l.rest.len())?,
             n_clusters: l.info.len(),
             n_particles: l.rest.len(),
+            substep: None,
+            pose_plan: Plan::default(),
+            leaf_plan: Plan::default(),
             time: 0.0,
             method: method.clone(),
             tree,
         };
         ctx.queue.write_buffer(&this.goal, 0, bytemuck::cast_slice(&rest_state.goal));
+        this.plan_pose(ctx);
         // The rest pose, until the first step writes one.
         let mut e = ctx.device.create_command_encoder(&Default::default());
         this.record_pose(ctx, &mut e);
-        ctx.queue.submit([e.finish()]);
+        ctx.submit([e.finish()]);
         Ok(this)
     }
 
@@ -161,92 +172,83 @@ impl GpuHsm {
             }
             ctx.queue.write_buffer(&self.steps, 0, bytemuck::cast_slice(&params));
             let mut e = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hsm") });
+            let substep = match self.substep.take() {
+                Some(p) => p,
+                None => self.plan_substep(ctx),
+            };
+            let size = std::mem::size_of::<RawHsmStep>() as u64;
             for k in 0..batch {
-                self.record_substep(ctx, &mut e, k);
+                e.copy_buffer_to_buffer(&self.steps, k as u64 * size, &self.step, 0, size);
+                substep.record(ctx, &mut e, "hsm substep");
             }
+            self.substep = Some(substep);
             done += batch;
             if done == total {
                 self.record_pose(ctx, &mut e);
             }
-            ctx.queue.submit([e.finish()]);
+            ctx.submit([e.finish()]);
         }
     }
 
-    fn record_substep(&self, ctx: &GpuContext, e: &mut wgpu::CommandEncoder, k: usize) {
-        let size = std::mem::size_of::<RawHsmStep>() as u64;
-        e.copy_buffer_to_buffer(&self.steps, k as u64 * size, &self.step, 0, size);
+    fn plan_substep(&self, ctx: &GpuContext) -> Plan {
         let lanes = sylva_core::methods::hsm::kernels::LANES as u32;
-        self.clusters_kernel.record(
-            ctx,
-            e,
-            &[
-                &self.wind.fields,
-                &self.wind.waves,
-                &self.info,
-                &self.clusters,
-                &self.slots,
-                &self.displacement,
-                &self.step,
-                &self.state,
-            ],
-            self.n_clusters as u32 * lanes,
-        );
+        let mut plan = Plan::default();
+        let buffers = [
+            &self.wind.fields,
+            &self.wind.waves,
+            &self.info,
+            &self.clusters,
+            &self.slots,
+            &self.displacement,
+            &self.step,
+            &self.state,
+        ];
+        plan.push(ctx, &self.clusters_kernel, &buffers, self.n_clusters as u32 * lanes);
+        let n = self.n_particles as u32;
         if self.fused {
-            self.particles_kernel.record(
-                ctx,
-                e,
-                &[
-                    &self.member_offset,
-                    &self.member,
-                    &self.state,
-                    &self.owner,
-                    &self.step,
-                    &self.displacement,
-                    &self.velocity,
-                ],
-                self.n_particles as u32,
-            );
-            return;
+            let buffers = [
+                &self.member_offset,
+                &self.member,
+                &self.state,
+                &self.owner,
+                &self.step,
+                &self.displacement,
+                &self.velocity,
+            ];
+            plan.push(ctx, &self.particles_kernel, &buffers, n);
+        } else {
+            plan.push(ctx, &self.goals_kernel, &[&self.member_offset, &self.member, &self.state, &self.goal], n);
+            let buffers = [&self.owner, &self.state, &self.goal, &self.step, &self.displacement, &self.velocity];
+            plan.push(ctx, &self.integrate_kernel, &buffers, n);
         }
-        self.goals_kernel.record(
-            ctx,
-            e,
-            &[&self.member_offset, &self.member, &self.state, &self.goal],
-            self.n_particles as u32,
-        );
-        self.integrate_kernel.record(
-            ctx,
-            e,
-            &[&self.owner, &self.state, &self.goal, &self.step, &self.displacement, &self.velocity],
-            self.n_particles as u32,
-        );
+        plan
     }
 
     fn record_pose(&self, ctx: &GpuContext, e: &mut wgpu::CommandEncoder) {
         if let Some(pose) = &self.pose {
-            self.pose_kernel.record(
-                ctx,
-                e,
-                &[&self.segment_cluster, &self.state, pose.acc_buffer()],
-                pose.segment_count() as u32,
-            );
-            pose.record_positions(ctx, e);
-            if !self.method.leaves.is_empty() {
-                self.leaf_pose_kernel.record(
-                    ctx,
-                    e,
-                    &[
-                        &self.leaves,
-                        &self.slots,
-                        &self.displacement,
-                        &self.state,
-                        pose.acc_buffer(),
-                        pose.leaf_buffer(),
-                    ],
-                    self.method.leaves.len() as u32,
-                );
-            }
+            // One pass: segment rotations, the joints from them, the leaves from both.
+            let mut pass = compute_pass(ctx, e, "hsm pose");
+            self.pose_plan.dispatch(ctx, &mut pass);
+            pose.dispatch_positions(ctx, &mut pass);
+            self.leaf_plan.dispatch(ctx, &mut pass);
         }
+    }
+
+    /// Binds the pose's kernels once (their buffers never change): the segments' rotations
+    /// from their clusters, and the leaves' from theirs.
+    fn plan_pose(&mut self, ctx: &GpuContext) {
+        let Some(pose) = &self.pose else { return };
+        let mut plan = Plan::default();
+        let buffers = [&self.segment_cluster, &self.state, pose.acc_buffer()];
+        plan.push(ctx, &self.pose_kernel, &buffers, pose.segment_count() as u32);
+        self.pose_plan = plan;
+        let mut plan = Plan::default();
+        if !self.method.leaves.is_empty() {
+            let buffers =
+                [&self.leaves, &self.slots, &self.displacement, &self.state, pose.acc_buffer(), pose.leaf_buffer()];
+            plan.push(ctx, &self.leaf_pose_kernel, &buffers, self.method.leaves.len() as u32);
+        }
+        self.leaf_plan = plan;
     }
 
     /// Reads the particle and cluster state back (waits for the GPU).
@@ -291,13 +293,14 @@ impl GpuAnimator for GpuHsm {
     }
     fn set_wind(&mut self, wind: &GpuWind) {
         self.wind = wind.clone();
+        self.substep = None;
     }
     fn reset(&mut self, ctx: &GpuContext, time: f32) {
         self.write_state(ctx, &self.method.state_at_rest());
         self.time = time;
         let mut e = ctx.device.create_command_encoder(&Default::default());
         self.record_pose(ctx, &mut e);
-        ctx.queue.submit([e.finish()]);
+        ctx.submit([e.finish()]);
     }
     fn advance(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
         self.advance_steps(ctx, dt, steps);

@@ -1,9 +1,10 @@
-//! Skjermo's method on the GPU: the step (ping-pong state buffers), the seam rotations and
-//! forward kinematics in one submission per step; the curves stay on the device for the
-//! deformer.
+//! Skjermo's method on the GPU: the steps (ping-pong state buffers, each step's time copied
+//! into the step buffer between dispatches), then the seam rotations and forward kinematics,
+//! all in one submission however many steps a frame advances; the curves stay on the device
+//! for the deformer.
 
 use super::{BuildError, GpuAnimator, GpuCurves};
-use crate::kernel::{Kernel, output, read_back, upload};
+use crate::kernel::{Kernel, Plan, output, read_back, upload};
 use crate::leaves::GpuLeafFlutter;
 use crate::pose::GpuPose;
 use crate::wind::GpuWind;
@@ -27,6 +28,13 @@ pub struct GpuSkjermo {
     stems: wgpu::Buffer,
     params: wgpu::Buffer,
     step: wgpu::Buffer,
+    /// The step parameters of the current submission, one after another.
+    steps: wgpu::Buffer,
+    steps_capacity: usize,
+    /// The step from state 0 to 1 and from 1 to 0, bound on first use after the wind is set.
+    plans: Option<[Plan; 2]>,
+    /// The seam's rotations from state 0 and from state 1.
+    rotation_plans: [Plan; 2],
     state: [wgpu::Buffer; 2],
     current: usize,
     modes: wgpu::Buffer,
@@ -59,7 +67,7 @@ impl GpuSkjermo {
         ctx.queue.write_buffer(&stems_buffer, 0, bytemuck::cast_slice(&stems));
         let rest: Vec<RawSkjermoState> =
             orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect();
-        Ok(Self {
+        let mut this = Self {
             leaves: GpuLeafFlutter::new(ctx, &method.leaves)?,
             step_kernel: Kernel::get(ctx, "skjermo_step"),
             rotations: Kernel::get(ctx, "skjermo_rotations"),
@@ -68,6 +76,9 @@ impl GpuSkjermo {
             stems: stems_buffer,
             params: upload(ctx, "segment params", &method.segment_param)?,
             step: upload(ctx, "skjermo step", &[method.step_params(0.0)])?,
+            steps: upload(ctx, "skjermo steps", &[method.step_params(0.0)])?,
+            steps_capacity: 1,
+            plans: None,
             state: [upload(ctx, "skjermo state a", &rest)?, upload(ctx, "skjermo state b", &rest)?],
             current: 0,
             modes: upload(ctx, "skjermo modes", &method.modes)?,
@@ -77,7 +88,17 @@ impl GpuSkjermo {
             method_step: method.step_params(0.0),
             time: 0.0,
             tree,
-        })
+            rotation_plans: Default::default(),
+        };
+        // The seam's rotations from either state buffer (their buffers never change).
+        this.rotation_plans = [0, 1].map(|current| {
+            let pose = &this.pose;
+            let buffers = [&this.params, &this.stems, &this.state[current], pose.parents_buffer(), pose.delta_buffer()];
+            let mut plan = Plan::default();
+            plan.push(ctx, &this.rotations, &buffers, pose.segment_count() as u32);
+            plan
+        });
+        Ok(this)
     }
 
     /// Skjermo's per-stem constants on the GPU (`RawSkjermoStem`).
@@ -105,45 +126,76 @@ impl GpuSkjermo {
             let (from, to) = (&orient[level % 2], &orient[1 - level % 2]);
             kernel.record(ctx, &mut e, &[stems, from, to], method.stems.len() as u32);
         }
-        ctx.queue.submit([e.finish()]);
+        ctx.submit([e.finish()]);
         read_back(ctx, &orient[levels % 2], method.stems.len())
     }
 
     /// Advances by one step of `dt` seconds (submitted, not waited for).
     pub fn step(&mut self, ctx: &GpuContext, dt: f32) {
-        self.step_with(ctx, dt, true);
+        self.advance_steps(ctx, dt, 1, true);
     }
 
     /// Advances the curves only (no pose): Skjermo's branch update as the paper measures it.
     pub fn step_only(&mut self, ctx: &GpuContext, dt: f32) {
-        self.step_with(ctx, dt, false);
+        self.advance_steps(ctx, dt, 1, false);
     }
 
-    fn step_with(&mut self, ctx: &GpuContext, dt: f32, with_pose: bool) {
-        self.time += dt;
-        let step = RawSkjermoStep { time: self.time, dt, ..self.method_step };
-        ctx.queue.write_buffer(&self.step, 0, bytemuck::bytes_of(&step));
-        let (prev, next) = (&self.state[self.current], &self.state[1 - self.current]);
-        let mut e = ctx.device.create_command_encoder(&Default::default());
-        self.step_kernel.record(
-            ctx,
-            &mut e,
-            &[&self.wind.fields, &self.wind.waves, &self.stems, prev, &self.step, next, &self.modes, &self.sway],
-            self.rest.len() as u32,
-        );
+    /// Advances by `steps` steps of `dt` seconds in one submission (not waited for): each
+    /// step's parameters are copied into the step buffer before its dispatch, the state
+    /// buffers ping-pong, and with `with_pose` the seam's rotations, forward kinematics and
+    /// leaves are written once, for the last step (the same pose as stepping one by one).
+    pub fn advance_steps(&mut self, ctx: &GpuContext, dt: f32, steps: usize, with_pose: bool) {
+        if steps == 0 {
+            return;
+        }
+        // Times accumulate step by step, as on the CPU.
+        let params: Vec<RawSkjermoStep> = (0..steps)
+            .map(|_| {
+                self.time += dt;
+                RawSkjermoStep { time: self.time, dt, ..self.method_step }
+            })
+            .collect();
+        if steps > self.steps_capacity {
+            self.steps = output::<RawSkjermoStep>(ctx, "skjermo steps", steps).expect("step parameters fit");
+            self.steps_capacity = steps;
+        }
+        ctx.queue.write_buffer(&self.steps, 0, bytemuck::cast_slice(&params));
+        let n = self.rest.len() as u32;
+        let plans = self.plans.get_or_insert_with(|| {
+            [0, 1].map(|from| {
+                let mut plan = Plan::default();
+                plan.push(
+                    ctx,
+                    &self.step_kernel,
+                    &[
+                        &self.wind.fields,
+                        &self.wind.waves,
+                        &self.stems,
+                        &self.state[from],
+                        &self.step,
+                        &self.state[1 - from],
+                        &self.modes,
+                        &self.sway,
+                    ],
+                    n,
+                );
+                plan
+            })
+        });
+        let size = std::mem::size_of::<RawSkjermoStep>() as u64;
+        let mut e = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("skjermo") });
+        for k in 0..steps {
+            e.copy_buffer_to_buffer(&self.steps, k as u64 * size, &self.step, 0, size);
+            plans[self.current].record(ctx, &mut e, "skjermo step");
+            self.current = 1 - self.current;
+        }
         if with_pose {
             let pose = &self.pose;
-            self.rotations.record(
-                ctx,
-                &mut e,
-                &[&self.params, &self.stems, next, pose.parents_buffer(), pose.delta_buffer()],
-                pose.segment_count() as u32,
-            );
+            self.rotation_plans[self.current].record(ctx, &mut e, "skjermo rotations");
             pose.record(ctx, &mut e);
             self.leaves.record_pose(ctx, &mut e, &self.wind, pose, self.time);
         }
-        ctx.queue.submit([e.finish()]);
-        self.current = 1 - self.current;
+        ctx.submit([e.finish()]);
     }
 
     /// Reads the current pose back, with the animated Béziers (waits for the GPU).
@@ -184,6 +236,7 @@ impl GpuAnimator for GpuSkjermo {
     }
     fn set_wind(&mut self, wind: &GpuWind) {
         self.wind = wind.clone();
+        self.plans = None;
     }
     fn reset(&mut self, ctx: &GpuContext, time: f32) {
         for s in &self.state {
@@ -195,9 +248,7 @@ impl GpuAnimator for GpuSkjermo {
         self.time = time;
     }
     fn advance(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
-        for _ in 0..steps {
-            self.step(ctx, dt);
-        }
+        self.advance_steps(ctx, dt, steps, true);
     }
     fn time(&self) -> f32 {
         self.time

@@ -4,7 +4,7 @@
 pub mod trunk_noise;
 
 use super::{BuildError, GpuAnimator};
-use crate::kernel::{Kernel, upload};
+use crate::kernel::{Kernel, Plan, upload};
 use crate::leaves::GpuLeafFlutter;
 use crate::pose::GpuPose;
 use crate::wind::GpuWind;
@@ -28,6 +28,8 @@ pub struct GpuZioma {
     frame: wgpu::Buffer,
     instances: Vec<Placement>,
     leaves: GpuLeafFlutter,
+    /// The rotation kernel, bound on first use after the wind is set.
+    rotations: Option<Plan>,
     /// The trunk's ring-down since the wind last changed (as the CPU's state).
     ring: Ring,
     /// Time of the pose, s.
@@ -63,6 +65,7 @@ impl GpuZioma {
             frame: upload(ctx, "zioma frames", &vec![zeroed; count])?,
             instances: instances.to_vec(),
             leaves: GpuLeafFlutter::new(ctx, &method.leaves)?,
+            rotations: None,
             tree,
             method,
             time: 0.0,
@@ -78,6 +81,15 @@ impl GpuZioma {
     /// per-instance frame values are computed on the CPU: the trunk's filtered wind and its
     /// bands each).
     pub fn submit(&mut self, ctx: &GpuContext, t: f32) {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.record(ctx, &mut encoder, t);
+        ctx.submit([encoder.finish()]);
+    }
+
+    /// Records every instance's pose at time `t` into `encoder`, for work that reads it in
+    /// the same submission (skinning, meshing); the frame values are written to the queue now,
+    /// so record one pose per submission.
+    pub fn record(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, t: f32) {
         self.time = t;
         let (m, w) = (&self.method, &*self.wind.packed);
         let frames: Vec<RawZiomaFrame> = if self.instances.is_empty() {
@@ -86,16 +98,22 @@ impl GpuZioma {
             m.frames_for(&w.fields, &w.waves, t, &self.instances, &self.ring)
         };
         ctx.queue.write_buffer(&self.frame, 0, bytemuck::cast_slice(&frames));
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        self.kernel.record(
-            ctx,
-            &mut encoder,
-            &[&self.wind.fields, &self.wind.waves, &self.segments, &self.stems, &self.frame, self.pose.delta_buffer()],
-            (self.pose.segment_count() * self.pose.instance_count()) as u32,
-        );
-        self.pose.record(ctx, &mut encoder);
-        self.leaves.record_pose(ctx, &mut encoder, &self.wind, &self.pose, t);
-        ctx.queue.submit([encoder.finish()]);
+        let plan = self.rotations.get_or_insert_with(|| {
+            let buffers = [
+                &self.wind.fields,
+                &self.wind.waves,
+                &self.segments,
+                &self.stems,
+                &self.frame,
+                self.pose.delta_buffer(),
+            ];
+            let mut plan = Plan::default();
+            plan.push(ctx, &self.kernel, &buffers, (self.pose.segment_count() * self.pose.instance_count()) as u32);
+            plan
+        });
+        plan.record(ctx, encoder, "zioma rotations");
+        self.pose.record(ctx, encoder);
+        self.leaves.record_pose(ctx, encoder, &self.wind, &self.pose, t);
     }
 
     /// Every instance's pose at time `t`.
@@ -139,6 +157,7 @@ impl GpuAnimator for GpuZioma {
             self.ring = self.method.ring_after(&self.wind.packed, &wind.packed, &self.ring, self.time);
         }
         self.wind = wind.clone();
+        self.rotations = None;
     }
     fn reset(&mut self, _ctx: &GpuContext, time: f32) {
         self.time = time;
