@@ -161,16 +161,7 @@ impl GpuContext {
             trace: wgpu::Trace::Off,
         }))
         .map_err(|e| GpuError::Device { adapter: summary.name.clone(), message: e.to_string() })?;
-        Ok(Self {
-            instance: Some(instance),
-            adapter,
-            device,
-            queue,
-            summary,
-            timestamps,
-            kernels: Default::default(),
-            counters: Default::default(),
-        })
+        Ok(Self::from_wgpu(Some(instance), adapter, device, queue))
     }
 
     /// A context on an application's own device, so an engine and Sylva share it. Kernels
