@@ -100,7 +100,10 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
         cpu: cpu_model(),
         cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
         threads: rayon::current_num_threads(),
-        gpu: ctx.map(|c| c.summary.to_string()),
+        gpu: ctx.map(|c| match c.subgroup_size {
+            Some(n) => format!("{}, subgroups of {n}", c.summary),
+            None => format!("{}, no fixed subgroup size", c.summary),
+        }),
         cpu_bandwidth: cpu_bandwidth(),
         gpu_bandwidth: match ctx {
             Some(c) => Some(gpu_bandwidth(c)?),

@@ -116,6 +116,10 @@ pub struct GpuContext {
     pub summary: AdapterSummary,
     /// Whether kernels can be timed with timestamp queries.
     pub timestamps: bool,
+    /// The device's subgroup size, when it has subgroup operations and one size (its
+    /// minimum and maximum agree, a power of two up to 64): kernels with a subgroup path use
+    /// it ([`crate::methods::hsm::GpuHsm`]'s stage 1).
+    pub subgroup_size: Option<u32>,
     /// Compiled kernels by name: each is compiled once per context (see
     /// [`crate::kernel::Kernel::cached`]).
     pub(crate) kernels:
@@ -147,8 +151,9 @@ impl GpuContext {
             device_type: format!("{:?}", info.device_type),
             driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
         };
-        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let required_features = if timestamps { wgpu::Features::TIMESTAMP_QUERY } else { wgpu::Features::empty() };
+        // Timestamp queries to time kernels, subgroup operations for HSM's stage 1: each when
+        // the adapter has it.
+        let required_features = adapter.features() & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::SUBGROUP);
         // The adapter's own limits: kernels need large storage buffers and, on some
         // adapters, workgroups above the 256-thread default.
         let required_limits = adapter.limits();
@@ -182,6 +187,11 @@ impl GpuContext {
             driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
         };
         let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let subgroup_size = (device.features().contains(wgpu::Features::SUBGROUP)
+            && info.subgroup_min_size == info.subgroup_max_size
+            && info.subgroup_min_size.is_power_of_two()
+            && info.subgroup_min_size <= 64)
+            .then_some(info.subgroup_min_size);
         Self {
             instance,
             adapter,
@@ -189,6 +199,7 @@ impl GpuContext {
             queue,
             summary,
             timestamps,
+            subgroup_size,
             kernels: Default::default(),
             counters: Default::default(),
         }

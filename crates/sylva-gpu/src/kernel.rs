@@ -42,6 +42,11 @@ pub struct Kernel {
 impl Kernel {
     /// Compiles `sources` (composed in order) with entry point `main`.
     pub fn new(ctx: &GpuContext, name: &'static str, sources: &[&str]) -> Self {
+        Self::with_constants(ctx, name, sources, &[])
+    }
+
+    /// [`Self::new`] with values for the module's pipeline-overridable constants.
+    pub fn with_constants(ctx: &GpuContext, name: &'static str, sources: &[&str], constants: &[(&str, f64)]) -> Self {
         let module = ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(name),
             source: wgpu::ShaderSource::Wgsl(crate::shaders::compose(sources).into()),
@@ -51,7 +56,7 @@ impl Kernel {
             layout: None,
             module: &module,
             entry_point: Some("main"),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             cache: None,
         });
         let layout = pipeline.get_bind_group_layout(0);
@@ -70,8 +75,18 @@ impl Kernel {
     /// The registered kernel `name` ([`crate::shaders::KERNELS`]), compiled on first use and
     /// shared after. Panics when no kernel has that name (names are constants of the crate).
     pub fn get(ctx: &GpuContext, name: &str) -> std::sync::Arc<Self> {
+        Self::get_with(ctx, name, &[])
+    }
+
+    /// [`Self::get`] for a kernel with pipeline-overridable constants: compiled with
+    /// `constants` on first use on this context, shared after (pass the same values on one
+    /// context, such as its [`GpuContext::subgroup_size`]).
+    pub fn get_with(ctx: &GpuContext, name: &str, constants: &[(&str, f64)]) -> std::sync::Arc<Self> {
         let def = crate::shaders::kernel(name).unwrap_or_else(|| panic!("no kernel `{name}` in shaders::KERNELS"));
-        Self::cached(ctx, def.name, def.sources)
+        let mut map = ctx.kernels.lock().unwrap_or_else(|e| e.into_inner());
+        map.entry(def.name)
+            .or_insert_with(|| std::sync::Arc::new(Self::with_constants(ctx, def.name, def.sources, constants)))
+            .clone()
     }
 
     /// Caps the workgroups in `x` below the device limit, so tests can exercise the spill

@@ -59,8 +59,13 @@ pub const SKJERMO_ROTATIONS: &str = include_str!("methods/skjermo/skjermo_rotati
 pub const SKJERMO_REST_ORIENT: &str = include_str!("methods/skjermo/skjermo_rest_orient.wgsl");
 /// Song's linearised tree (`HsmCluster`, …) and the rotation extraction.
 pub const HSM: &str = include_str!("methods/hsm/hsm.wgsl");
-/// Kernel: HSM stage 1, per cluster (workgroup reduction).
+/// HSM stage 1's bindings, lane sums and per-cluster finish, shared by its two kernels.
+pub const HSM_CLUSTER_STAGE: &str = include_str!("methods/hsm/hsm_cluster_stage.wgsl");
+/// Kernel: HSM stage 1, per cluster (workgroup reduction in shared memory).
 pub const HSM_CLUSTERS: &str = include_str!("methods/hsm/hsm_clusters.wgsl");
+/// Kernel: HSM stage 1 with the reduction's last strides by subgroup shuffles (the same
+/// additions in the same order); `SUBGROUP_SIZE` is set when the pipeline is made.
+pub const HSM_CLUSTERS_SUBGROUP: &str = include_str!("methods/hsm/hsm_clusters_subgroup.wgsl");
 /// Stage 3's per-particle gather (`hsm_particle_goal`), shared by two kernels.
 pub const HSM_GATHER: &str = include_str!("methods/hsm/hsm_gather.wgsl");
 /// Kernel: HSM stage 3, per-particle goals.
@@ -136,7 +141,8 @@ kernels! {
     skjermo_step: [QUAT, TREE, NOISE, WIND, OSCILLATOR, SKJERMO, SKJERMO_STEP] => sylva_core::methods::skjermo::kernels::skjermo_step;
     skjermo_rotations: [QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS] => sylva_core::methods::skjermo::kernels::skjermo_rotations;
     skjermo_rest_orient: [QUAT, TREE, SKJERMO, SKJERMO_REST_ORIENT] => sylva_core::methods::skjermo::kernels::skjermo_rest_orient;
-    hsm_clusters: [QUAT, NOISE, WIND, HSM, HSM_CLUSTERS] => sylva_core::methods::hsm::kernels::hsm_clusters;
+    hsm_clusters: [QUAT, NOISE, WIND, HSM, HSM_CLUSTER_STAGE, HSM_CLUSTERS] => sylva_core::methods::hsm::kernels::hsm_clusters;
+    hsm_clusters_subgroup: [QUAT, NOISE, WIND, HSM, HSM_CLUSTER_STAGE, HSM_CLUSTERS_SUBGROUP] => sylva_core::methods::hsm::kernels::hsm_clusters_subgroup;
     hsm_goals: [QUAT, HSM, HSM_GATHER, HSM_GOALS] => sylva_core::methods::hsm::kernels::hsm_goals;
     hsm_integrate: [QUAT, HSM, HSM_ADVANCE, HSM_INTEGRATE] => sylva_core::methods::hsm::kernels::hsm_integrate;
     hsm_particles: [QUAT, HSM, HSM_GATHER, HSM_ADVANCE, HSM_PARTICLES] => sylva_core::methods::hsm::kernels::hsm_particles;

@@ -25,6 +25,24 @@ fn worst(a: &HsmState, b: &HsmState) -> f32 {
     a.max_distance(b)
 }
 
+/// A random state of `h`: particles displaced up to 5 mm, random velocities, random
+/// warm-start rotations, a random time.
+fn random_state(h: &Hsm, rng: &mut impl Rng) -> HsmState {
+    let mut state = h.state_at_rest();
+    for (p, v) in state.displacement.iter_mut().zip(state.velocity.iter_mut()) {
+        for k in 0..3 {
+            p[k] += rng.random_range(-0.005..0.005);
+            v[k] = rng.random_range(-3.0..3.0);
+        }
+    }
+    for c in &mut state.clusters {
+        let axis = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
+        c.rotation = glam::Quat::from_axis_angle(axis, rng.random_range(-0.5..0.5)).to_array();
+    }
+    state.time = rng.random_range(0.0..100.0);
+    state
+}
+
 /// One substep from a random state (particles displaced up to 5 mm, random velocities,
 /// random warm-start rotations), through the four stages and through the fused pass: each
 /// stage's output agrees within 1e-5 × tree height (positions, goals) and 1e-5 (rotations).
@@ -42,18 +60,7 @@ fn hsm_one_substep_matches_from_random_states() {
         let t = tree(name);
         let params = HsmParams { substep_rate: 240.0, beta, fused, ..Default::default() };
         let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(3000)).unwrap());
-        let mut state = h.state_at_rest();
-        for (p, v) in state.displacement.iter_mut().zip(state.velocity.iter_mut()) {
-            for k in 0..3 {
-                p[k] += rng.random_range(-0.005..0.005);
-                v[k] = rng.random_range(-3.0..3.0);
-            }
-        }
-        for c in &mut state.clusters {
-            let axis = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
-            c.rotation = glam::Quat::from_axis_angle(axis, rng.random_range(-0.5..0.5)).to_array();
-        }
-        state.time = rng.random_range(0.0..100.0);
+        let state = random_state(&h, &mut rng);
         let mut gpu =
             GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap())
                 .unwrap();
@@ -121,6 +128,46 @@ fn hsm_matches_after_1000_steps_on_every_preset() {
             assert!((*a - *b).length() <= 1e-4 * height, "{}: joint {i} {a} vs {b}", p.name);
         }
         println!("hsm 1000 steps {:<16} worst particle difference {:.2e} × height", p.name, d / height);
+    }
+}
+
+/// Stage 1's two reductions, in shared memory throughout and by subgroup shuffles below the
+/// subgroup size, add the same terms in the same order: from random states, in gusty wind,
+/// steps give the same state bit for bit (and the tests above run the subgroup path, the
+/// default, against the CPU). CI's device (lavapipe, subgroups of 8) must have one size.
+#[test]
+fn hsm_subgroup_reduction_gives_the_shared_memory_bits() {
+    let Some(ctx) = common::gpu() else { return };
+    let Some(size) = ctx.subgroup_size else {
+        assert!(std::env::var("CI").is_err(), "CI's GPU adapter must have subgroups of one size");
+        eprintln!("skipping the subgroup path: {} has no fixed subgroup size", ctx.summary);
+        return;
+    };
+    let wind = WindScene::resolve("gusty").unwrap();
+    let gpu_wind = GpuWind::from_scene(ctx, &wind).unwrap();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(0x5b);
+    for name in ["quaking_aspen", "palm"] {
+        let t = tree(name);
+        let params = HsmParams { substep_rate: 240.0, ..Default::default() };
+        let h = Arc::new(Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(2000)).unwrap()));
+        // Clusters whose lanes carry terms both above and below the subgroup size.
+        assert!(h.layout.info.iter().any(|c| c.slot_count > 2 * size), "{name}: no cluster wider than two subgroups");
+        let state = random_state(&h, &mut rng);
+        let tree = Some(Arc::new(t.clone()));
+        let mut subgroups = GpuHsm::new(ctx, tree.clone(), h.clone(), &gpu_wind).unwrap();
+        let mut shared = GpuHsm::new(ctx, tree, h.clone(), &gpu_wind).unwrap();
+        shared.set_subgroups(ctx, false);
+        assert!(subgroups.subgroups() && !shared.subgroups());
+        for g in [&mut subgroups, &mut shared] {
+            g.write_state(ctx, &state);
+            g.advance_steps(ctx, 1.0 / 60.0, 3);
+        }
+        let (a, b) = (subgroups.read_state(ctx).unwrap(), shared.read_state(ctx).unwrap());
+        assert_eq!(a.displacement, b.displacement, "{name}: particles");
+        assert_eq!(a.velocity, b.velocity, "{name}: velocities");
+        assert_eq!(a.clusters, b.clusters, "{name}: cluster states");
+        assert!(a.max_distance(&state) > 0.0, "{name}: nothing moved");
+        println!("hsm {name}: subgroups of {size} give the shared-memory reduction's bits");
     }
 }
 

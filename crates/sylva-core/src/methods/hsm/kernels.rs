@@ -1,7 +1,8 @@
 //! CPU twins of `hsm_clusters.wgsl`, `hsm_goals.wgsl`, `hsm_integrate.wgsl` and
 //! `hsm_pose.wgsl`: Song's four stages (see [`crate::methods::hsm`]). Same operations in the
 //! same order as the WGSL: a cluster's sums go through the GPU's [`LANES`] lanes (lane `j mod
-//! 64` takes slot `j`) and the same halving tree, so both sides add in the same order.
+//! 64` takes slot `j`) and the same halving tree, so both sides add in the same order (the
+//! GPU's subgroup kernel makes the tree's last strides by shuffles, the same additions).
 
 use crate::methods::hsm::{
     RawHsmCluster, RawHsmClusterInfo, RawHsmClusterState, RawHsmMember, RawHsmSlot, RawHsmStep, kind,
@@ -164,7 +165,7 @@ pub const MAX_WEIGHT: f32 = 1e6;
 /// of the cluster instead of its distance from rest (a palm frond's tip travels metres),
 /// and with them their rounding: a GPU that rounds differently then agrees with the CPU
 /// far better (palm, 1,000 steps on an H100: 4.9e-4 × height apart before, 1.9e-5 after).
-/// WGSL: the slot loop of `hsm_clusters.wgsl`.
+/// WGSL: the slot loop of `hsm_lane_sums` in `hsm_cluster_stage.wgsl`.
 #[inline(always)]
 fn slot_terms(x: [f32; 4], sp: Vec3A, s: &RawHsmSlot) -> [Vec3A; 4] {
     let m = x[3];
@@ -200,6 +201,10 @@ pub fn hsm_clusters(
 
 /// Scratch of one chunk of stage 1: a cluster's quarter lanes (see [`cluster_sums`]).
 pub(crate) type Quarter = [[Vec3A; 4]; LANES / 4];
+
+/// The CPU twin of `hsm_clusters_subgroup.wgsl`: the same additions in the same order as
+/// [`hsm_clusters`] (the GPU makes the tree's strides below its subgroup size by shuffles).
+pub use self::hsm_clusters as hsm_clusters_subgroup;
 
 /// [`hsm_clusters`] with each cluster's sums `[Σ m u, Apq columns]` about the shift `sp`
 /// from `sums(cluster, sp, scratch)`, which must add as [`cluster_sums`] does (the CPU's fast
@@ -304,7 +309,7 @@ pub fn reconfiguration(u: Vec3, step: &RawHsmStep) -> f32 {
     drag.reconfiguration(u.length())
 }
 
-/// Lane `t`'s sums as invocation `t` of `hsm_clusters.wgsl` adds them: zero, plus slot `t`,
+/// Lane `t`'s sums as invocation `t` of stage 1 adds them (`hsm_lane_sums`): zero, plus slot `t`,
 /// slot `t + 64`, …; zero for a lane past the slot count.
 #[inline(always)]
 fn lane_sums(run: &[RawHsmSlot], displacement: &[[f32; 4]], sp: Vec3A, t: usize) -> [Vec3A; 4] {

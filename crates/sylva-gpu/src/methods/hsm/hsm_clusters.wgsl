@@ -1,23 +1,5 @@
-// hsm_clusters (Song §5.2 stage 1): one workgroup per cluster, its particles as
-// invocations; centre of mass and Apq summed in shared memory (each invocation strides over
-// the slots, then a tree reduction), then one invocation extracts R, forms the goal
-// transform, α and the wind. CPU twin: sylva_core::methods::hsm::kernels::hsm_clusters (same lanes, same
-// reduction tree). Bindings: 0 fields, 1 waves, 2 cluster info, 3 clusters, 4 slots,
-// 5 displacements from rest (w = mass), 6 step, 7 cluster state.
-
-@group(0) @binding(2) var<storage, read> info: array<HsmClusterInfo>;
-@group(0) @binding(3) var<storage, read> clusters: array<HsmCluster>;
-@group(0) @binding(4) var<storage, read> slots: array<HsmSlot>;
-@group(0) @binding(5) var<storage, read> displacement: array<vec4<f32>>;
-@group(0) @binding(6) var<storage, read> step: HsmStep;
-@group(0) @binding(7) var<storage, read_write> state: array<HsmClusterState>;
-
-const LANES: u32 = 64u;
-
-var<workgroup> red_m: array<vec3<f32>, 64>;
-var<workgroup> red_a0: array<vec3<f32>, 64>;
-var<workgroup> red_a1: array<vec3<f32>, 64>;
-var<workgroup> red_a2: array<vec3<f32>, 64>;
+// hsm_clusters (Song §5.2 stage 1, `hsm_cluster_stage.wgsl`): the 64 lanes added by a
+// tree in shared memory.
 
 @compute @workgroup_size(64)
 fn main(
@@ -29,73 +11,9 @@ fn main(
     if (c >= arrayLength(&info)) {
         return;
     }
-    let inf = info[c];
-    // The shift at the last substep, subtracted from every displacement (see the CPU twin's
-    // slot_terms: Σ m q = 0, so Apq is unchanged, and the terms keep the cluster's size).
-    let st0 = state[c].transform;
-    let sp = vec3<f32>(st0[0].w, st0[1].w, st0[2].w);
-    var sm = vec3<f32>(0.0);
-    var a0 = vec3<f32>(0.0);
-    var a1 = vec3<f32>(0.0);
-    var a2 = vec3<f32>(0.0);
-    for (var j = t; j < inf.slot_count; j += LANES) {
-        let s = slots[inf.slot_offset + j];
-        let x = displacement[s.particle];
-        let m = x.w;
-        let u = x.xyz - sp;
-        let q = s.q;
-        sm += u * m;
-        let d = u + q;
-        a0 += (d * q.x) * m;
-        a1 += (d * q.y) * m;
-        a2 += (d * q.z) * m;
+    let sp = hsm_last_shift(c);
+    hsm_reduce_shared(t, hsm_lane_sums(c, t, sp), 0u);
+    if (t == 0u) {
+        hsm_finish_cluster(c, sp, HsmSums(red_m[0], red_a0[0], red_a1[0], red_a2[0]));
     }
-    red_m[t] = sm;
-    red_a0[t] = a0;
-    red_a1[t] = a1;
-    red_a2[t] = a2;
-    workgroupBarrier();
-    for (var s = LANES / 2u; s > 0u; s >>= 1u) {
-        if (t < s) {
-            red_m[t] = red_m[t] + red_m[t + s];
-            red_a0[t] = red_a0[t] + red_a0[t + s];
-            red_a1[t] = red_a1[t] + red_a1[t + s];
-            red_a2[t] = red_a2[t] + red_a2[t + s];
-        }
-        workgroupBarrier();
-    }
-    if (t != 0u) {
-        return;
-    }
-    let cl = clusters[c];
-    let c0 = cl.rest_cm.xyz;
-    let shift = sp + red_m[0] / cl.mass;
-    let cm = c0 + shift;
-    let apq = mat3x3<f32>(red_a0[0], red_a1[0], red_a2[0]);
-    let q = extract_rotation(apq, state[c].rotation, step.polar_iterations);
-    let r = quat_to_mat3(q);
-    var tr = r;
-    if (step.beta > 0.0) {
-        let aqq_inv = mat3x3<f32>(cl.aqq_inv[0].xyz, cl.aqq_inv[1].xyz, cl.aqq_inv[2].xyz);
-        let a = apq * aqq_inv;
-        let det = determinant(a);
-        if (det > 1e-6) {
-            tr = a * (step.beta / pow(det, 1.0 / 3.0)) + r * (1.0 - step.beta);
-        }
-    }
-    // The cluster's weight k h², past 1 only up to its path's k̂ h² (see MAX_WEIGHT).
-    let bound = max(cl.aqq_inv[0].w * step.dt * step.dt, step.hold);
-    let weight = min(min(cl.rest_cm.w * step.dt * step.dt, bound), MAX_WEIGHT);
-    var u = vec3<f32>(0.0);
-    if (inf.kind != HSM_LEAF) {
-        u = wind_at(cm, step.time);
-    }
-    state[c].cm = vec4<f32>(cm, weight);
-    state[c].rotation = q;
-    state[c].transform = array<vec4<f32>, 3>(
-        vec4<f32>(tr[0], shift.x),
-        vec4<f32>(tr[1], shift.y),
-        vec4<f32>(tr[2], shift.z),
-    );
-    state[c].wind = vec4<f32>(u, hsm_reconfiguration(u, step));
 }

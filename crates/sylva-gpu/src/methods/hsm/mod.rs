@@ -86,7 +86,7 @@ impl GpuHsm {
         };
         let step = method.step_params(0.0, 0.0);
         let mut this = Self {
-            clusters_kernel: Kernel::get(ctx, "hsm_clusters"),
+            clusters_kernel: clusters_kernel(ctx, true),
             goals_kernel: Kernel::get(ctx, "hsm_goals"),
             integrate_kernel: Kernel::get(ctx, "hsm_integrate"),
             particles_kernel: Kernel::get(ctx, "hsm_particles"),
@@ -140,6 +140,19 @@ impl GpuHsm {
     /// The method's layout and parameters.
     pub fn method(&self) -> &Arc<Hsm> {
         &self.method
+    }
+
+    /// Stage 1's reduction: by subgroup shuffles below the subgroup size (the default where
+    /// [`GpuContext::subgroup_size`] is known), or in shared memory throughout. Both add the
+    /// same terms in the same order, so they give the same bits.
+    pub fn set_subgroups(&mut self, ctx: &GpuContext, on: bool) {
+        self.clusters_kernel = clusters_kernel(ctx, on);
+        self.substep = None;
+    }
+
+    /// Whether stage 1 reduces by subgroup shuffles ([`Self::set_subgroups`]).
+    pub fn subgroups(&self) -> bool {
+        self.clusters_kernel.name == "hsm_clusters_subgroup"
     }
 
     /// Advances by one step of `dt` seconds in the method's substeps, all in one submission
@@ -267,6 +280,15 @@ impl GpuHsm {
     /// tree.
     pub fn read_pose(&self, ctx: &GpuContext) -> Result<Option<Pose>, GpuError> {
         self.pose.as_ref().map(|p| p.read(ctx)).transpose()
+    }
+}
+
+/// Stage 1's kernel: with `subgroups` and a device of one subgroup size, the reduction by
+/// shuffles below it; else in shared memory.
+fn clusters_kernel(ctx: &GpuContext, subgroups: bool) -> Arc<Kernel> {
+    match ctx.subgroup_size {
+        Some(size) if subgroups => Kernel::get_with(ctx, "hsm_clusters_subgroup", &[("SUBGROUP_SIZE", size as f64)]),
+        _ => Kernel::get(ctx, "hsm_clusters"),
     }
 }
 
