@@ -68,8 +68,21 @@ impl Kernel {
     /// rasteriser). Sylva's own kernels come by [`Self::get`]; this is for kernels of
     /// methods defined outside the crate, under names of their own.
     pub fn cached(ctx: &GpuContext, name: &'static str, sources: &[&str]) -> std::sync::Arc<Self> {
+        Self::cached_with(ctx, name, sources, &[])
+    }
+
+    /// [`Self::cached`] with values for the module's pipeline-overridable constants, used on
+    /// first compilation.
+    fn cached_with(
+        ctx: &GpuContext,
+        name: &'static str,
+        sources: &[&str],
+        constants: &[(&str, f64)],
+    ) -> std::sync::Arc<Self> {
         let mut map = ctx.kernels.lock().unwrap_or_else(|e| e.into_inner());
-        map.entry(name).or_insert_with(|| std::sync::Arc::new(Self::new(ctx, name, sources))).clone()
+        map.entry(name)
+            .or_insert_with(|| std::sync::Arc::new(Self::with_constants(ctx, name, sources, constants)))
+            .clone()
     }
 
     /// The registered kernel `name` ([`crate::shaders::KERNELS`]), compiled on first use and
@@ -83,10 +96,7 @@ impl Kernel {
     /// context, such as its [`GpuContext::subgroup_size`]).
     pub fn get_with(ctx: &GpuContext, name: &str, constants: &[(&str, f64)]) -> std::sync::Arc<Self> {
         let def = crate::shaders::kernel(name).unwrap_or_else(|| panic!("no kernel `{name}` in shaders::KERNELS"));
-        let mut map = ctx.kernels.lock().unwrap_or_else(|e| e.into_inner());
-        map.entry(def.name)
-            .or_insert_with(|| std::sync::Arc::new(Self::with_constants(ctx, def.name, def.sources, constants)))
-            .clone()
+        Self::cached_with(ctx, def.name, def.sources, constants)
     }
 
     /// Caps the workgroups in `x` below the device limit, so tests can exercise the spill
@@ -97,7 +107,7 @@ impl Kernel {
     }
 
     /// Binds `buffers` at 0, 1, 2, … for this kernel, once, for dispatches recorded many
-    /// times ([`Self::record_bound`], [`Self::dispatch`]): creating a bind group is most of
+    /// times ([`Self::dispatch`], [`Plan`]): creating a bind group is most of
     /// what recording a small dispatch costs the CPU.
     pub fn bind(&self, ctx: &GpuContext, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
         let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
@@ -123,20 +133,8 @@ impl Kernel {
         invocations: u32,
     ) {
         let bind = self.bind(ctx, buffers);
-        self.record_bound(ctx, encoder, &bind, invocations);
-    }
-
-    /// Records a dispatch of `invocations` work items on a bind group from [`Self::bind`], in
-    /// a pass of its own.
-    pub fn record_bound(
-        &self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        bind: &wgpu::BindGroup,
-        invocations: u32,
-    ) {
         let mut pass = compute_pass(ctx, encoder, self.name);
-        self.dispatch(ctx, &mut pass, bind, invocations);
+        self.dispatch(ctx, &mut pass, &bind, invocations);
     }
 
     /// Records a dispatch of `invocations` work items on a bind group from [`Self::bind`]
@@ -230,16 +228,6 @@ impl Plan {
         for (kernel, bind, invocations) in &self.0 {
             kernel.dispatch(ctx, pass, bind, *invocations);
         }
-    }
-
-    /// The dispatches recorded by [`Self::record`].
-    pub fn len(&self) -> usize {
-        self.0.len()
-    }
-
-    /// Whether there is nothing to record.
-    pub fn is_empty(&self) -> bool {
-        self.0.is_empty()
     }
 }
 
