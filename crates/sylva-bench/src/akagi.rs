@@ -19,10 +19,12 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 use serde::Serialize;
+use std::mem::size_of;
 use std::path::PathBuf;
 use sylva_core::Tree;
-use sylva_core::mesh::{MeshLayout, MeshParams};
+use sylva_core::mesh::{MeshLayout, MeshParams, RawRing, RawVertex};
 use sylva_core::methods::zioma::{Zioma, ZiomaParams};
+use sylva_core::model::{RawLeaf, RawSegment};
 use sylva_core::pose::seam_buffers;
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
@@ -44,6 +46,8 @@ pub struct AkagiRow {
     pub trees: usize,
     /// Bytes written and read per frame (vertices out, rings, leaves and pose in).
     pub bytes_per_frame: usize,
+    /// `bytes_per_frame` over the triangles.
+    pub bytes_per_triangle: f64,
     /// CPU one thread, ms per frame (median, min, max).
     pub cpu_one_ms: Option<[f64; 3]>,
     /// CPU all threads, ms per frame.
@@ -135,8 +139,10 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             acc.extend(a);
         }
         let vertices = layout.tube_vertex_count() + layout.leaf_vertex_count();
-        let bytes =
-            vertices * 32 + layout.rings.len() * 32 + layout.leaves.len() * 48 + layout.segments.len() * (96 + 32);
+        let bytes = vertices * size_of::<RawVertex>()
+            + layout.rings.len() * size_of::<RawRing>()
+            + layout.leaves.len() * size_of::<RawLeaf>()
+            + layout.segments.len() * (size_of::<RawSegment>() + 2 * size_of::<[f32; 4]>());
         let info = layout.info();
         let mut tubes = vec![bytemuck::Zeroable::zeroed(); layout.tube_vertex_count()];
         let mut leaves = vec![bytemuck::Zeroable::zeroed(); layout.leaf_vertex_count()];
@@ -184,6 +190,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             vertices,
             trees: members.len(),
             bytes_per_frame: bytes,
+            bytes_per_triangle: bytes as f64 / layout.triangle_count().max(1) as f64,
             cpu_one_ms: cpu_one.map(|r| r.ms()),
             cpu_all_ms: cpu_all.map(|r| r.ms()),
             gpu_ms: gpu.map(|r| r.ms()),
@@ -211,18 +218,17 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     let mut md = markdown_head("Akagi & Kitajima Table 2: mesh regeneration per frame", "akagi-t2", env.machine);
     md += "ms per frame, median (min–max). The paper: Core2 QX9650 one thread, GeForce GTX 280, generation + drawing.\n\n";
     md += &format!(
-        "| paper triangles | paper CPU ms | paper GPU ms | paper CPU/GPU | triangles | trees | MB/frame | CPU 1 thread ms | CPU all threads ms | CPU % of bandwidth | GPU ms | GPU % of bandwidth | CPU 1 thread / GPU | CPU all / GPU | {} |\n",
+        "| paper triangles | paper CPU ms | paper GPU ms | paper CPU/GPU | triangles | trees | MB/frame | B/triangle | CPU 1 thread ms | CPU all threads ms | CPU % of bandwidth | GPU ms | GPU % of bandwidth | CPU 1 thread / GPU | CPU all / GPU | {} |\n",
         COMMANDS_HEADING.replace("step", "frame")
     );
-    md +=
-        "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let ratio = |a: Option<[f64; 3]>, b: Option<[f64; 3]>| match (a, b) {
         (Some(a), Some(b)) => format!("{:.1}", a[0] / b[0]),
         _ => "–".into(),
     };
     for r in &out {
         md += &format!(
-            "| {} | {:.2} | {:.3} | {:.0} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {:.2} | {:.3} | {:.0} | {} | {} | {:.1} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.paper_triangles,
             r.paper_cpu_ms,
             r.paper_gpu_ms,
@@ -230,6 +236,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             r.triangles,
             r.trees,
             r.bytes_per_frame as f64 / 1e6,
+            r.bytes_per_triangle,
             cell(r.cpu_one_ms),
             cell(r.cpu_all_ms),
             r.cpu_bandwidth_fraction.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f)),

@@ -613,7 +613,7 @@ fn hierarchy_attributes_tangents_and_static_export_mean_what_the_docs_say() {
         for (v, tg) in verts.iter().zip(tangents(verts, idx)) {
             let tv = Vec3::new(tg[0], tg[1], tg[2]);
             assert!((tv.length() - 1.0).abs() < 1e-5);
-            assert!(tv.dot(Vec3::from_array(v.normal)).abs() < 1e-4);
+            assert!(tv.dot(v.normal()).abs() < 1e-4);
             assert!(tg[3] == 1.0 || tg[3] == -1.0);
         }
     }

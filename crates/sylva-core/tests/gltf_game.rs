@@ -443,7 +443,7 @@ fn mikktspace_tangents_follow_u_across_a_card_and_around_a_stem() {
     use sylva_core::mesh::RawVertex;
     // A card in the x–y plane facing +z, u along +x and v along +y: tangent +x, w +1
     // (the bitangent n × t = +y, along v).
-    let corner = |x: f32, y: f32| RawVertex { position: [x, y, 0.0], u: x, normal: [0.0, 0.0, 1.0], v: y };
+    let corner = |x: f32, y: f32| RawVertex::new(glam::Vec3::new(x, y, 0.0), glam::Vec3::Z, x, y);
     let card = [corner(0.0, 0.0), corner(1.0, 0.0), corner(1.0, 1.0), corner(0.0, 1.0)];
     for t in tangents(&card, &[0, 1, 2, 0, 2, 3]) {
         assert!(Vec3::from_slice(&t[..3]).distance(Vec3::X) < 1e-6 && t[3] == 1.0, "{t:?}");

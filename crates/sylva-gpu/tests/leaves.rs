@@ -208,8 +208,8 @@ fn meshed_leaves_follow_their_rotations_on_both() {
     for (k, (a, b)) in gpu.leaves.iter().zip(&cpu.leaves).enumerate() {
         let d = (Vec3::from_array(a.position) - Vec3::from_array(b.position)).length();
         assert!(d <= 1e-5 * h, "leaf vertex {k}: GPU {:?}, CPU {:?}", a.position, b.position);
-        let dn = (Vec3::from_array(a.normal) - Vec3::from_array(b.normal)).length();
-        assert!(dn <= 1e-3, "leaf vertex {k}: normal {:?} vs {:?}", a.normal, b.normal);
+        let dn = (a.normal() - b.normal()).length();
+        assert!(dn <= 1e-3, "leaf vertex {k}: normal {:?} vs {:?}", a.normal(), b.normal());
         let l = layout.leaves[k / stride].index as usize;
         if l % 3 == 0 {
             assert_eq!(b.position, rest.leaves[k].position, "leaf {l} at rest moved on the CPU");
@@ -266,7 +266,7 @@ fn skinned_leaves_follow_their_rotations() {
     for (k, (a, b)) in gpu.leaves.iter().zip(&cpu.leaves).enumerate() {
         let d = (Vec3::from_array(a.position) - Vec3::from_array(b.position)).length();
         assert!(d <= 1e-5 * h, "skinned leaf vertex {k}: GPU {:?}, CPU {:?}", a.position, b.position);
-        let dn = (Vec3::from_array(a.normal) - Vec3::from_array(b.normal)).length();
-        assert!(dn <= 1e-3, "skinned leaf vertex {k}: normal {:?} vs {:?}", a.normal, b.normal);
+        let dn = (a.normal() - b.normal()).length();
+        assert!(dn <= 1e-3, "skinned leaf vertex {k}: normal {:?} vs {:?}", a.normal(), b.normal());
     }
 }

@@ -39,8 +39,8 @@ fn compare(t: &Tree, cpu: &MeshFrame, gpu: &MeshFrame, what: &str) -> f32 {
         let d = (Vec3::from_array(a.position) - Vec3::from_array(b.position)).length();
         worst = worst.max(d / h);
         assert!(d <= 1e-5 * h, "{what}: vertex {k} {:?} vs {:?}", a.position, b.position);
-        let dn = (Vec3::from_array(a.normal) - Vec3::from_array(b.normal)).length();
-        assert!(dn <= 1e-3, "{what}: vertex {k} normal {:?} vs {:?}", a.normal, b.normal);
+        let dn = (a.normal() - b.normal()).length();
+        assert!(dn <= 1e-3, "{what}: vertex {k} normal {:?} vs {:?}", a.normal(), b.normal());
         assert!((a.u - b.u).abs() <= 1e-5 && (a.v - b.v).abs() <= 1e-5 * a.v.abs().max(1.0), "{what}: vertex {k} uv");
     }
     worst
@@ -194,5 +194,90 @@ fn gpu_deformer_matches_cpu_on_every_preset() {
         let frame = |v: Vec<RawVertex>| MeshFrame { tubes: v, leaves: Vec::new() };
         let worst = compare(&t, &frame(cpu), &frame(gpu), &format!("deformer {}", preset.name));
         println!("deformer {}: {} vertices, worst {worst:.1e} × height", preset.name, layout.vertex_count());
+    }
+}
+
+/// `oct_encode` / `oct_decode` in `vertex.wgsl` against their CPU twins on random unit
+/// vectors, the axes and the octahedron's fold: each snorm16 component within one step
+/// (WGSL's division may differ from the CPU's by an ulp before rounding), decoding within
+/// 1e-6.
+#[test]
+fn octahedral_normals_match_their_cpu_twin() {
+    use sylva_core::mesh::{oct_decode, oct_encode};
+    use sylva_gpu::kernel::{output, read_back, upload};
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    let mut normals: Vec<Vec3> =
+        [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z, Vec3::new(1.0, 1.0, -1e-7)]
+            .into_iter()
+            .chain((0..4096).map(|_| {
+                Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0))
+            }))
+            .map(|n| n.normalize_or(Vec3::Z))
+            .collect();
+    normals.push(Vec3::ZERO);
+    let cpu_bits: Vec<u32> = normals.iter().map(|&n| oct_encode(n)).collect();
+    let src = format!(
+        "{}
+@group(0) @binding(0) var<storage, read> normal: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read> bits: array<u32>;
+@group(0) @binding(2) var<storage, read_write> encoded: array<u32>;
+@group(0) @binding(3) var<storage, read_write> decoded: array<vec4<f32>>;
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
+    let i = gid.x;
+    if (i < arrayLength(&bits)) {{
+        encoded[i] = oct_encode(normal[i].xyz);
+        decoded[i] = vec4<f32>(oct_decode(bits[i]), 0.0);
+    }}
+}}",
+        sylva_gpu::shaders::VERTEX
+    );
+    let module = ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("oct twin"),
+        source: wgpu::ShaderSource::Wgsl(src.into()),
+    });
+    let pipeline = ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("oct twin"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let n = normals.len();
+    let padded: Vec<[f32; 4]> = normals.iter().map(|v| v.extend(0.0).to_array()).collect();
+    let buffers = [
+        upload(ctx, "normals", &padded).unwrap(),
+        upload(ctx, "bits", &cpu_bits).unwrap(),
+        output::<u32>(ctx, "encoded", n).unwrap(),
+        output::<[f32; 4]>(ctx, "decoded", n).unwrap(),
+    ];
+    let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("oct twin"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &std::array::from_fn::<_, 4, _>(|i| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: buffers[i].as_entire_binding(),
+        }),
+    });
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(n.div_ceil(64) as u32, 1, 1);
+    }
+    ctx.submit([encoder.finish()]);
+    let encoded: Vec<u32> = read_back(ctx, &buffers[2], n).unwrap();
+    let decoded: Vec<[f32; 4]> = read_back(ctx, &buffers[3], n).unwrap();
+    let component = |b: u32, k: u32| ((b >> (16 * k)) & 0xffff) as u16 as i16 as i32;
+    for i in 0..n {
+        for k in 0..2 {
+            let (g, c) = (component(encoded[i], k), component(cpu_bits[i], k));
+            assert!((g - c).abs() <= 1, "normal {i} {:?}: component {k} GPU {g} vs CPU {c}", normals[i]);
+        }
+        let d = (Vec3::from_slice(&decoded[i][..3]) - oct_decode(cpu_bits[i])).length();
+        assert!(d <= 1e-6, "normal {i}: decoded {:?} vs {:?}", decoded[i], oct_decode(cpu_bits[i]));
     }
 }

@@ -469,8 +469,8 @@ fn hsm_structs_match_their_wgsl_twins() {
 #[test]
 fn mesh_structs_match_their_wgsl_twins() {
     use sylva_core::mesh::{RawDetail, RawMeshInfo, RawRing, RawVertex};
-    use sylva_gpu::shaders::{MESH, NOISE};
-    let src = compose(&[NOISE, MESH]);
+    use sylva_gpu::shaders::{MESH, NOISE, VERTEX};
+    let src = compose(&[NOISE, MESH, VERTEX]);
     check_in(
         &src,
         "Ring",
@@ -519,8 +519,8 @@ fn mesh_structs_match_their_wgsl_twins() {
         size_of::<RawVertex>(),
         &[
             ("position", offset_of!(RawVertex, position)),
+            ("normal_oct", offset_of!(RawVertex, normal_oct)),
             ("u", offset_of!(RawVertex, u)),
-            ("normal", offset_of!(RawVertex, normal)),
             ("v", offset_of!(RawVertex, v)),
         ],
     );
@@ -529,8 +529,8 @@ fn mesh_structs_match_their_wgsl_twins() {
 #[test]
 fn skin_structs_match_their_wgsl_twins() {
     use sylva_core::mesh::{RawSkin, RawSkinInfo};
-    use sylva_gpu::shaders::{MESH, NOISE, QUAT, SKIN_VERTICES};
-    let src = compose(&[QUAT, NOISE, MESH, SKIN_VERTICES]);
+    use sylva_gpu::shaders::{MESH, NOISE, QUAT, SKIN_VERTICES, VERTEX};
+    let src = compose(&[QUAT, NOISE, MESH, VERTEX, SKIN_VERTICES]);
     check_in(
         &src,
         "Skin",
@@ -558,8 +558,8 @@ fn skin_structs_match_their_wgsl_twins() {
 #[test]
 fn deformer_structs_match_their_wgsl_twins() {
     use sylva_core::mesh::{RawDeformRing, RawDeformShape};
-    use sylva_gpu::shaders::{MESH, NOISE, QUAT, SKJERMO, SKJERMO_DEFORM};
-    let src = compose(&[QUAT, TREE, NOISE, MESH, SKJERMO, SKJERMO_DEFORM]);
+    use sylva_gpu::shaders::{MESH, NOISE, QUAT, SKJERMO, SKJERMO_DEFORM, VERTEX};
+    let src = compose(&[QUAT, TREE, NOISE, MESH, VERTEX, SKJERMO, SKJERMO_DEFORM]);
     check_in(
         &src,
         "DeformShape",

@@ -2,7 +2,6 @@
 //! item (Akagi §2.3). See [`crate::mesh`] for the construction.
 
 use crate::mesh::{RawDetail, RawMeshInfo, RawVertex, bark_relief};
-use glam::Vec3;
 use rayon::prelude::*;
 
 /// Writes detail d's vertex `vertex[rings × (sides + 1) + d]` from the two ring vertices of
@@ -13,13 +12,13 @@ pub fn mesh_detail(info: &RawMeshInfo, detail: &[RawDetail], vertex: &mut [RawVe
     let (ring_vertices, out) = vertex.split_at_mut((info.rings * (info.sides + 1)) as usize);
     out.par_iter_mut().zip(detail.par_iter()).for_each(|(v, d)| {
         let (a, b) = (&ring_vertices[d.a as usize], &ring_vertices[d.b as usize]);
-        let normal = (Vec3::from_array(a.normal) + Vec3::from_array(b.normal)).normalize();
+        let normal = (a.normal() + b.normal()).normalize();
         let (u, vv) = (0.5 * (a.u + b.u), 0.5 * (a.v + b.v));
-        let mut p = (Vec3::from_array(a.position) + Vec3::from_array(b.position)) * 0.5;
+        let mut p = (a.pos() + b.pos()) * 0.5;
         if d.scale != 0.0 {
             let ends = 0.5 * (bark_relief(a.u, a.v, d.stem_seed) + bark_relief(b.u, b.v, d.stem_seed));
             p += normal * (d.scale * (bark_relief(u, vv, d.stem_seed) - ends));
         }
-        *v = RawVertex { position: p.to_array(), u, normal: normal.to_array(), v: vv };
+        *v = RawVertex::new(p, normal, u, vv);
     });
 }

@@ -37,14 +37,14 @@ pub fn mesh_leaves(
         let lambda = leaf_rotation.get(lf.index as usize).copied().unwrap_or([0.0, 0.0, 0.0, 1.0]);
         let q = if lambda == [0.0, 0.0, 0.0, 1.0] { d * rest } else { d * (Quat::from_array(lambda) * rest) };
         let (qx, qy) = (q * Vec3::X, q * Vec3::Y);
-        let normal = (q * Vec3::Z).to_array();
+        let normal = q * Vec3::Z;
         let rim = &rims[(lf.shape as usize).min(rims.len() - 1)];
         for (k, v) in out.iter_mut().enumerate() {
             // (u, v) on the blade: the centre, then the rim from the base through +u to the
             // tip and back, scaled to width and length.
             let uv = if k > 0 { rim[k - 1] } else { (0.5, 0.5) };
             let p = base + qx * ((uv.0 - 0.5) * lf.width) + qy * (uv.1 * lf.length);
-            *v = RawVertex { position: p.to_array(), u: uv.0, normal, v: uv.1 };
+            *v = RawVertex::new(p, normal, uv.0, uv.1);
         }
     });
 }

@@ -47,6 +47,7 @@ pub mod skin;
 mod skin_vertices;
 mod skjermo_deform;
 mod tubes;
+mod vertex;
 
 pub use deformer::{DeformLayout, DeformerParams, RawDeformRing, RawDeformShape, deform_radius};
 pub use detail::mesh_detail;
@@ -55,6 +56,7 @@ pub use skin::{RawSkin, RawSkinInfo, SkinLayout};
 pub use skin_vertices::skin_vertices;
 pub use skjermo_deform::skjermo_deform;
 pub use tubes::mesh_tubes;
+pub use vertex::{RawVertex, oct_decode, oct_encode};
 
 use crate::model::{NONE, RawLeaf, RawSegment, Tree};
 use crate::pose::Pose;
@@ -192,21 +194,6 @@ pub struct RawDetail {
     pub _pad: [u32; 2],
 }
 
-/// One output vertex, 32 bytes: position and `u`, normal and `v`. WGSL: `struct Vertex` in
-/// `mesh.wgsl`; the renderer draws the buffer the kernels write as it is.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct RawVertex {
-    /// Position, m.
-    pub position: [f32; 3],
-    /// Texture coordinate u.
-    pub u: f32,
-    /// Unit normal.
-    pub normal: [f32; 3],
-    /// Texture coordinate v.
-    pub v: f32,
-}
-
 /// The fixed topology of one tree's mesh.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshLayout {
@@ -250,7 +237,7 @@ pub enum MeshError {
 }
 
 /// Largest number of vertices of one mesh (tubes or leaves): indices are u32 and a GPU
-/// storage binding holds 128 MiB on the smallest device Sylva supports (4 Mi × 32 B).
+/// storage binding holds 128 MiB on the smallest device Sylva supports (4 Mi × 24 B fits).
 pub const MAX_VERTICES: u64 = 4 << 20;
 
 impl MeshLayout {

@@ -34,7 +34,7 @@ pub fn skin_vertices(
     out.par_iter_mut().enumerate().for_each(|(id, o)| {
         let (inst, v) = (id / n, id % n);
         let base = (info.first_instance as usize + inst) * info.segments as usize;
-        let (mut x, mut nrm) = (Vec3::from_array(rest[v].position), Vec3::from_array(rest[v].normal));
+        let (mut x, mut nrm) = (rest[v].pos(), rest[v].normal());
         let s = skin[v];
         if s.leaf > 0 {
             let l = (s.leaf - 1) as usize;
@@ -51,6 +51,6 @@ pub fn skin_vertices(
         let w = s.weight;
         let p = (j0 + d0 * (x - r0)) * (1.0 - w) + (j1 + d1 * (x - r1)) * w;
         let normal = ((d0 * nrm) * (1.0 - w) + (d1 * nrm) * w).normalize();
-        *o = RawVertex { position: p.to_array(), u: rest[v].u, normal: normal.to_array(), v: rest[v].v };
+        *o = RawVertex::new(p, normal, rest[v].u, rest[v].v);
     });
 }

@@ -71,12 +71,7 @@ pub fn mesh_tubes(
                 let around = kk as f32 / info.sides as f32;
                 p += normal * (rg.relief * radius * bark_relief(around, rg.v, rg.stem_seed));
             }
-            *v = RawVertex {
-                position: p.to_array(),
-                u: k as f32 / info.sides as f32,
-                normal: normal.to_array(),
-                v: rg.v,
-            };
+            *v = RawVertex::new(p, normal, k as f32 / info.sides as f32, rg.v);
         }
     });
 }

@@ -1,5 +1,5 @@
 // Per-frame meshing (Akagi §2.2–2.4): structs shared by mesh_tubes, mesh_detail and
-// mesh_leaves, twins of sylva_core::mesh::{RawRing, RawMeshInfo, RawDetail, RawVertex}, and
+// mesh_leaves, twins of sylva_core::mesh::{RawRing, RawMeshInfo, RawDetail}, and
 // the bark relief.
 
 const TAU: f32 = 6.283185307179586;
@@ -33,13 +33,6 @@ struct Detail {
     scale: f32,
     stem_seed: u32,
     _pad: array<u32, 2>,
-}
-
-struct Vertex {
-    position: vec3<f32>,
-    u: f32,
-    normal: vec3<f32>,
-    v: f32,
 }
 
 // Bark relief in -1..1 (CPU twin: sylva_core::mesh::bark_relief).

@@ -16,13 +16,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let d = detail[i];
     let a = vertex[d.a];
     let b = vertex[d.b];
-    let normal = normalize(a.normal + b.normal);
+    let normal = normalize(oct_decode(a.normal_oct) + oct_decode(b.normal_oct));
     let u = 0.5 * (a.u + b.u);
     let v = 0.5 * (a.v + b.v);
-    var p = (a.position + b.position) * 0.5;
+    var p = (vertex_pos(a) + vertex_pos(b)) * 0.5;
     if (d.scale != 0.0) {
         let ends = 0.5 * (bark_relief(a.u, a.v, d.stem_seed) + bark_relief(b.u, b.v, d.stem_seed));
         p += normal * (d.scale * (bark_relief(u, v, d.stem_seed) - ends));
     }
-    vertex[info.rings * (info.sides + 1u) + i] = Vertex(p, u, normal, v);
+    vertex[info.rings * (info.sides + 1u) + i] = vertex_new(p, normal, u, v);
 }

@@ -41,6 +41,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             uv = leaf_rim(lf.shape, k - 1u, info.leaf_sides);
         }
         let p = base + qx * ((uv.x - 0.5) * lf.width) + qy * (uv.y * lf.length);
-        vertex[l * stride + k] = Vertex(p, uv.x, normal, uv.y);
+        vertex[l * stride + k] = vertex_new(p, normal, uv.x, uv.y);
     }
 }

@@ -66,6 +66,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         if (rg.relief != 0.0) {
             p += normal * (rg.relief * radius * bark_relief(around, rg.v, rg.stem_seed));
         }
-        vertex[r * stride + k] = Vertex(p, f32(k) / f32(info.sides), normal, rg.v);
+        vertex[r * stride + k] = vertex_new(p, normal, f32(k) / f32(info.sides), rg.v);
     }
 }

@@ -36,8 +36,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let inst = id / info.vertices;
     let v = id % info.vertices;
     let base = (info.first_instance + inst) * info.segments;
-    var x = rest[v].position;
-    var nrm = rest[v].normal;
+    var x = vertex_pos(rest[v]);
+    var nrm = oct_decode(rest[v].normal_oct);
     let s = skin[v];
     // A leaf vertex turns about its leaf's attachment first (the identity leaves it be).
     if (s.leaf > 0u && s.leaf - 1u < arrayLength(&leaf_rotation) && s.leaf - 1u < arrayLength(&leaf_attach)) {
@@ -53,5 +53,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let p1 = joint[base + s.bone1].xyz + quat_rotate(acc[base + s.bone1], x - rest_joint[s.bone1].xyz);
     let p = p0 * (1.0 - w) + p1 * w;
     let normal = normalize(quat_rotate(acc[base + s.bone0], nrm) * (1.0 - w) + quat_rotate(acc[base + s.bone1], nrm) * w);
-    out[id] = Vertex(p, rest[v].u, normal, rest[v].v);
+    out[id] = vertex_new(p, normal, rest[v].u, rest[v].v);
 }

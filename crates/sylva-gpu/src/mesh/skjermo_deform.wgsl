@@ -121,6 +121,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let a = d_theta * (1.0 / max(length(d_theta), 1e-30));
         let b = d_u * (1.0 / max(length(d_u), 1e-30));
         let normal = unit_or(cross(a, b), s0);
-        vertex[r_index * stride + ci] = Vertex(pos, f32(ci) / f32(info.sides), normal, rg.tex_v);
+        vertex[r_index * stride + ci] = vertex_new(pos, normal, f32(ci) / f32(info.sides), rg.tex_v);
     }
 }

@@ -14,7 +14,8 @@ use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
 /// The renderer's WGSL (validated by naga in the tests).
-pub const RENDER_WGSL: &str = concat!(include_str!("../wgsl/leaf_shape.wgsl"), include_str!("render.wgsl"));
+pub const RENDER_WGSL: &str =
+    concat!(include_str!("../wgsl/leaf_shape.wgsl"), include_str!("../mesh/vertex.wgsl"), include_str!("render.wgsl"));
 
 const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -109,7 +110,7 @@ pub struct Instance {
 }
 
 /// GPU twin of [`Instance`], 80 bytes: four matrix columns and the tint (vertex attributes
-/// 2–6 of `render.wgsl`).
+/// 3–7 of `render.wgsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawInstance {
@@ -148,7 +149,8 @@ pub struct RawGlobals {
 /// Vertex and index buffers of one material.
 #[derive(Debug, Clone, Copy)]
 pub struct MeshBuffers<'a> {
-    /// Vertices ([`sylva_core::mesh::RawVertex`]), written by a mesh or skinning kernel.
+    /// Vertices ([`sylva_core::mesh::RawVertex`], 24 bytes: `Float32x3` position, `Snorm16x2`
+    /// octahedral normal, `Float32x2` uv), written by a mesh or skinning kernel.
     pub vertices: &'a wgpu::Buffer,
     /// Triangle indices.
     pub indices: &'a wgpu::Buffer,
@@ -207,9 +209,10 @@ pub enum RenderError {
 }
 
 fn vertex_layouts() -> [Option<wgpu::VertexBufferLayout<'static>>; 2] {
-    const VERTEX: [wgpu::VertexAttribute; 2] = wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4];
+    // sylva_core::mesh::RawVertex: position, octahedral normal, uv.
+    const VERTEX: [wgpu::VertexAttribute; 3] = wgpu::vertex_attr_array![0 => Float32x3, 1 => Snorm16x2, 2 => Float32x2];
     const INSTANCE: [wgpu::VertexAttribute; 5] =
-        wgpu::vertex_attr_array![2 => Float32x4, 3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4];
+        wgpu::vertex_attr_array![3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4];
     [
         Some(wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<sylva_core::mesh::RawVertex>() as u64,

@@ -134,14 +134,16 @@ fn fs_ground(v: GroundOut) -> @location(0) vec4<f32> {
 
 // ---- trees: bark and leaves from the mesh kernels' vertex buffers, instanced ----------------
 
+// sylva_core::mesh::RawVertex (vertex.wgsl, composed before this file), then the instance.
 struct VertexIn {
-    @location(0) position_u: vec4<f32>,
-    @location(1) normal_v: vec4<f32>,
-    @location(2) m0: vec4<f32>,
-    @location(3) m1: vec4<f32>,
-    @location(4) m2: vec4<f32>,
-    @location(5) m3: vec4<f32>,
-    @location(6) tint: vec4<f32>,
+    @location(0) position: vec3<f32>,
+    @location(1) normal_oct: vec2<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) m0: vec4<f32>,
+    @location(4) m1: vec4<f32>,
+    @location(5) m2: vec4<f32>,
+    @location(6) m3: vec4<f32>,
+    @location(7) tint: vec4<f32>,
 }
 
 struct TreeOut {
@@ -154,9 +156,9 @@ struct TreeOut {
 
 fn to_world(v: VertexIn) -> TreeOut {
     let model = mat4x4<f32>(v.m0, v.m1, v.m2, v.m3);
-    let w = model * vec4<f32>(v.position_u.xyz, 1.0);
-    let n = normalize((model * vec4<f32>(v.normal_v.xyz, 0.0)).xyz);
-    return TreeOut(g.view_proj * w, w.xyz, n, vec2<f32>(v.position_u.w, v.normal_v.w), v.tint);
+    let w = model * vec4<f32>(v.position, 1.0);
+    let n = normalize((model * vec4<f32>(oct_unfold(v.normal_oct), 0.0)).xyz);
+    return TreeOut(g.view_proj * w, w.xyz, n, v.uv, v.tint);
 }
 
 @vertex
@@ -206,7 +208,7 @@ fn fs_leaf(v: TreeOut, @builtin(front_facing) front: bool) -> @location(0) vec4<
 @vertex
 fn vs_shadow(v: VertexIn) -> @builtin(position) vec4<f32> {
     let model = mat4x4<f32>(v.m0, v.m1, v.m2, v.m3);
-    return g.sun_view_proj * (model * vec4<f32>(v.position_u.xyz, 1.0));
+    return g.sun_view_proj * (model * vec4<f32>(v.position, 1.0));
 }
 
 struct ShadowLeafOut {
@@ -218,8 +220,8 @@ struct ShadowLeafOut {
 @vertex
 fn vs_shadow_leaf(v: VertexIn) -> ShadowLeafOut {
     let model = mat4x4<f32>(v.m0, v.m1, v.m2, v.m3);
-    let clip = g.sun_view_proj * (model * vec4<f32>(v.position_u.xyz, 1.0));
-    return ShadowLeafOut(clip, vec2<f32>(v.position_u.w, v.normal_v.w), v.tint.w);
+    let clip = g.sun_view_proj * (model * vec4<f32>(v.position, 1.0));
+    return ShadowLeafOut(clip, v.uv, v.tint.w);
 }
 
 // Leaves cast the shadow of their outline, not of the polygon around it.

@@ -222,7 +222,7 @@ impl Builder {
             Some((lo.to_vec(), hi.to_vec())),
         );
         attributes.insert(Valid(Semantic::Positions), position);
-        let normals: Vec<Vec3> = v.iter().map(|x| Vec3::from_array(x.normal).normalize()).collect();
+        let normals: Vec<Vec3> = v.iter().map(|x| x.normal()).collect();
         let (normal, tangent) = if fmt.quantize {
             let n: Vec<i8> = normals.iter().flat_map(|n| n.to_array().map(snorm8)).collect();
             let t: Vec<i8> = g.tangents.iter().flat_map(|t| t.map(snorm8)).collect();

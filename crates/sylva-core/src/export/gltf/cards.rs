@@ -18,12 +18,12 @@ pub(super) fn cards(leaves: &[RawLeaf]) -> (Vec<RawVertex>, Vec<RawSkin>, Vec<u3
     let mut indices = Vec::with_capacity(leaves.len() * 6);
     for (k, l) in leaves.iter().enumerate() {
         let q = Quat::from_array(l.orientation);
-        let (x, y, normal) = (q * Vec3::X, q * Vec3::Y, (q * Vec3::Z).to_array());
+        let (x, y, normal) = (q * Vec3::X, q * Vec3::Y, q * Vec3::Z);
         let side = (l.width.max(0.0) * l.length.max(0.0)).sqrt();
         let base = Vec3::from_array(l.position);
         for (u, v) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
             let p = base + x * ((u - 0.5) * side) + y * (v * side);
-            vertices.push(RawVertex { position: p.to_array(), u, normal, v });
+            vertices.push(RawVertex::new(p, normal, u, v));
             skin.push(RawSkin { bone0: l.segment, bone1: l.segment, weight: 0.0, leaf: l.index + 1 });
         }
         let c = (k * CARD_VERTICES) as u32;

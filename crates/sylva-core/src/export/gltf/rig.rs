@@ -306,7 +306,7 @@ pub fn tangents(vertices: &[RawVertex], indices: &[u32]) -> Vec<[f32; 4]> {
             self.at(face, vert).position
         }
         fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
-            Vec3::from_array(self.at(face, vert).normal).normalize_or_zero().to_array()
+            self.at(face, vert).normal().to_array()
         }
         fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
             let v = self.at(face, vert);
@@ -325,7 +325,7 @@ pub fn tangents(vertices: &[RawVertex], indices: &[u32]) -> Vec<[f32; 4]> {
         .iter()
         .zip(mesh.out)
         .map(|(v, t)| {
-            let n = Vec3::from_array(v.normal).normalize_or(Vec3::Y);
+            let n = v.normal();
             match t {
                 Some([x, y, z, w]) => match Vec3::new(x, y, z).try_normalize() {
                     Some(t) => [t.x, t.y, t.z, if w < 0.0 { -1.0 } else { 1.0 }],
