@@ -88,6 +88,8 @@ pub const LEAF_FLUTTER: &str = include_str!("leaves/leaf_flutter.wgsl");
 pub const HSM_POSE: &str = include_str!("methods/hsm/hsm_pose.wgsl");
 /// The 24-byte output vertex (`Vertex`, octahedral normals), twin of `sylva_core::mesh::RawVertex`.
 pub const VERTEX: &str = include_str!("mesh/vertex.wgsl");
+/// Coalesced output of runs of vertices through workgroup memory (`put_vertex`, `flush_stage`).
+pub const VERTEX_STAGE: &str = include_str!("mesh/vertex_stage.wgsl");
 /// Per-frame meshing structs (`Ring`, `MeshInfo`, `Detail`) and the bark relief.
 pub const MESH: &str = include_str!("mesh/mesh.wgsl");
 /// Kernel: bark vertices of every tube.
@@ -152,11 +154,11 @@ kernels! {
     hsm_leaf_pose: [QUAT, HSM, HSM_LEAF_POSE] => sylva_core::methods::hsm::kernels::hsm_leaf_pose;
     leaf_wind: [QUAT, NOISE, WIND, LEAVES, LEAF_WIND] => sylva_core::leaves::kernels::leaf_wind;
     leaf_flutter: [QUAT, NOISE, LEAVES, LEAF_FLUTTER] => sylva_core::leaves::kernels::leaf_flutter;
-    mesh_tubes: [QUAT, TREE, NOISE, MESH, VERTEX, MESH_TUBES] => sylva_core::mesh::mesh_tubes;
+    mesh_tubes: [QUAT, TREE, NOISE, MESH, VERTEX, VERTEX_STAGE, MESH_TUBES] => sylva_core::mesh::mesh_tubes;
     mesh_detail: [NOISE, MESH, VERTEX, MESH_DETAIL] => sylva_core::mesh::mesh_detail;
-    mesh_leaves: [QUAT, TREE, NOISE, MESH, VERTEX, LEAF_SHAPE, MESH_LEAVES] => sylva_core::mesh::mesh_leaves;
+    mesh_leaves: [QUAT, TREE, NOISE, MESH, VERTEX, VERTEX_STAGE, LEAF_SHAPE, MESH_LEAVES] => sylva_core::mesh::mesh_leaves;
     skin_vertices: [QUAT, NOISE, MESH, VERTEX, SKIN_VERTICES] => sylva_core::mesh::skin_vertices;
-    skjermo_deform: [QUAT, TREE, NOISE, MESH, VERTEX, SKJERMO, SKJERMO_DEFORM] => sylva_core::mesh::skjermo_deform;
+    skjermo_deform: [QUAT, TREE, NOISE, MESH, VERTEX, VERTEX_STAGE, SKJERMO, SKJERMO_DEFORM] => sylva_core::mesh::skjermo_deform;
 }
 
 /// The registered kernel `name`.

@@ -558,8 +558,8 @@ fn skin_structs_match_their_wgsl_twins() {
 #[test]
 fn deformer_structs_match_their_wgsl_twins() {
     use sylva_core::mesh::{RawDeformRing, RawDeformShape};
-    use sylva_gpu::shaders::{MESH, NOISE, QUAT, SKJERMO, SKJERMO_DEFORM, VERTEX};
-    let src = compose(&[QUAT, TREE, NOISE, MESH, VERTEX, SKJERMO, SKJERMO_DEFORM]);
+    use sylva_gpu::shaders::{MESH, NOISE, QUAT, SKJERMO, SKJERMO_DEFORM, VERTEX, VERTEX_STAGE};
+    let src = compose(&[QUAT, TREE, NOISE, MESH, VERTEX, VERTEX_STAGE, SKJERMO, SKJERMO_DEFORM]);
     check_in(
         &src,
         "DeformShape",

@@ -1,6 +1,7 @@
 // mesh_leaves: one leaf per invocation (Akagi §2.4): the leaf's transform once, then its
 // polygon — k = 0 the centre, 1.. the rim (leaf_rim: the disc's two half-circles, or a
-// polygon holding the leaf's outline), scaled to the blade, turned by the leaf's rotation.
+// polygon holding the leaf's outline), scaled to the blade, turned by the leaf's rotation;
+// the workgroup's leaves written out together (vertex_stage.wgsl).
 // CPU twin: sylva_core::mesh::mesh_leaves (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> info: MeshInfo;
@@ -8,16 +9,27 @@
 @group(0) @binding(2) var<storage, read> segment: array<Segment>;
 @group(0) @binding(3) var<storage, read> joint: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> acc: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read_write> vertex: array<Vertex>;
+@group(0) @binding(5) var<storage, read_write> vertex_words: array<u32>;
 @group(0) @binding(6) var<storage, read> leaf_rotation: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let l = gid.x + gid.y * nwg.x * 64u;
-    if (l >= info.leaves) {
-        return;
-    }
+fn main(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+) {
+    let first = (wid.x + wid.y * nwg.x) * 64u;
     let stride = info.leaf_sides + 1u;
+    let staged = stage_fits(stride);
+    let l = first + lane;
+    if (l < info.leaves) {
+        leaf_vertices(l, lane, stride, staged);
+    }
+    let count = select(0u, min(64u, info.leaves - first), first < info.leaves);
+    flush_stage(staged, first * stride, count * stride, lane);
+}
+
+fn leaf_vertices(l: u32, lane: u32, stride: u32, staged: bool) {
     let lf = leaf[l];
     let s = lf.segment;
     let d = acc[s];
@@ -41,6 +53,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             uv = leaf_rim(lf.shape, k - 1u, info.leaf_sides);
         }
         let p = base + qx * ((uv.x - 0.5) * lf.width) + qy * (uv.y * lf.length);
-        vertex[l * stride + k] = vertex_new(p, normal, uv.x, uv.y);
+        put_vertex(staged, lane * stride + k, l * stride + k, vertex_new(p, normal, uv.x, uv.y));
     }
 }

@@ -1,6 +1,7 @@
 // mesh_tubes: one ring per invocation (Akagi §2.2–2.3): the Hermite centreline point and
 // the slerped frame once, then the unit polygon placed around it with the interpolated
-// radius and the bark relief along the normal (sides + 1 vertices, the last the seam).
+// radius and the bark relief along the normal (sides + 1 vertices, the last the seam),
+// written out by the workgroup together (vertex_stage.wgsl).
 // CPU twin: sylva_core::mesh::mesh_tubes (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> info: MeshInfo;
@@ -8,19 +9,30 @@
 @group(0) @binding(2) var<storage, read> segment: array<Segment>;
 @group(0) @binding(3) var<storage, read> joint: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> acc: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read_write> vertex: array<Vertex>;
+@group(0) @binding(5) var<storage, read_write> vertex_words: array<u32>;
 
 fn world_orientation(i: u32) -> vec4<f32> {
     return quat_mul(acc[i], segment[i].orientation);
 }
 
 @compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let r = gid.x + gid.y * nwg.x * 64u;
-    if (r >= info.rings) {
-        return;
-    }
+fn main(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+) {
+    let first = (wid.x + wid.y * nwg.x) * 64u;
     let stride = info.sides + 1u;
+    let staged = stage_fits(stride);
+    let r = first + lane;
+    if (r < info.rings) {
+        ring_vertices(r, lane, stride, staged);
+    }
+    let count = select(0u, min(64u, info.rings - first), first < info.rings);
+    flush_stage(staged, first * stride, count * stride, lane);
+}
+
+fn ring_vertices(r: u32, lane: u32, stride: u32, staged: bool) {
     let rg = ring[r];
     let i = rg.segment;
     let seg = segment[i];
@@ -66,6 +78,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         if (rg.relief != 0.0) {
             p += normal * (rg.relief * radius * bark_relief(around, rg.v, rg.stem_seed));
         }
-        vertex[r * stride + k] = vertex_new(p, normal, f32(k) / f32(info.sides), rg.v);
+        put_vertex(staged, lane * stride + k, r * stride + k, vertex_new(p, normal, f32(k) / f32(info.sides), rg.v));
     }
 }

@@ -1,6 +1,7 @@
 // skjermo_deform: Skjermo's deformer (§3), one grid ring per invocation: the unbent branch
 // (eqs. 1-6), the generalised de Casteljau deformation along the stem's current Bézier with
-// Sloan's handles (eqs. 7-9), normals through the Jacobian (eq. 10).
+// Sloan's handles (eqs. 7-9), normals through the Jacobian (eq. 10); the workgroup's rings
+// written out together (vertex_stage.wgsl).
 // CPU twin: sylva_core::mesh::skjermo_deform (same bindings, same loop body).
 
 struct DeformShape {
@@ -30,7 +31,7 @@ const MIN_RADIUS_FRACTION: f32 = 0.1;
 @group(0) @binding(2) var<storage, read> shape: array<DeformShape>;
 @group(0) @binding(3) var<storage, read> stems: array<SkjermoStem>;
 @group(0) @binding(4) var<storage, read> state: array<SkjermoState>;
-@group(0) @binding(5) var<storage, read_write> vertex: array<Vertex>;
+@group(0) @binding(5) var<storage, read_write> vertex_words: array<u32>;
 
 // Radius of the unbent branch and its derivatives in v and theta (eqs. 2-5; CPU twin:
 // sylva_core::mesh::deform_radius).
@@ -64,12 +65,23 @@ fn deform_radius(s: DeformShape, v: f32, theta: f32) -> vec3<f32> {
 }
 
 @compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let r_index = gid.x + gid.y * nwg.x * 64u;
-    if (r_index >= info.rings) {
-        return;
-    }
+fn main(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+) {
+    let first = (wid.x + wid.y * nwg.x) * 64u;
     let stride = info.sides + 1u;
+    let staged = stage_fits(stride);
+    let r_index = first + lane;
+    if (r_index < info.rings) {
+        ring_vertices(r_index, lane, stride, staged);
+    }
+    let count = select(0u, min(64u, info.rings - first), first < info.rings);
+    flush_stage(staged, first * stride, count * stride, lane);
+}
+
+fn ring_vertices(r_index: u32, lane: u32, stride: u32, staged: bool) {
     let rg = ring[r_index];
     let k = rg.stem;
     let st = stems[k];
@@ -121,6 +133,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let a = d_theta * (1.0 / max(length(d_theta), 1e-30));
         let b = d_u * (1.0 / max(length(d_u), 1e-30));
         let normal = unit_or(cross(a, b), s0);
-        vertex[r_index * stride + ci] = vertex_new(pos, normal, f32(ci) / f32(info.sides), rg.tex_v);
+        let x = vertex_new(pos, normal, f32(ci) / f32(info.sides), rg.tex_v);
+        put_vertex(staged, lane * stride + ci, r_index * stride + ci, x);
     }
 }
