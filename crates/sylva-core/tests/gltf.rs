@@ -344,7 +344,7 @@ fn sylva_skinned(t: &Tree, c: &Clip, k: usize) -> (Vec<Vec3>, Vec<bool>) {
     let layout = MeshLayout::new(t, MeshParams::default()).unwrap();
     let skin = SkinLayout::new(&layout);
     let m = skin.skin(&c.joints[k], &c.acc[k], 1);
-    let rigid: Vec<bool> = m.tubes.iter().map(|_| true).chain(skin.leaf_rest.iter().map(|v| v.v <= 0.0)).collect();
+    let rigid: Vec<bool> = m.tubes.iter().map(|_| true).chain(layout.leaf_uv().iter().map(|uv| uv[1] <= 0.0)).collect();
     assert!(rigid.iter().filter(|r| **r).count() >= m.tubes.len() + layout.leaves.len(), "a base per leaf");
     (m.tubes.iter().chain(&m.leaves).map(|v| Vec3::from_array(v.position)).collect(), rigid)
 }
@@ -442,13 +442,12 @@ fn leaf_joints_turn_leaves_relative_to_their_segment_in_the_read_back_clip() {
     let bark = layout.tube_vertex_count();
     let stride = layout.params.leaf_sides as usize + 1;
     // Per leaf: its base (least v), tip (most v) and widest point on +u, from the rest mesh.
-    let pick = |l: usize, key: &dyn Fn(&sylva_core::mesh::RawVertex) -> f32| {
-        (l * stride..(l + 1) * stride)
-            .max_by(|&a, &b| key(&skin.leaf_rest[a]).total_cmp(&key(&skin.leaf_rest[b])))
-            .unwrap()
+    let leaf_uv = layout.leaf_uv();
+    let pick = |l: usize, key: &dyn Fn(&sylva_core::mesh::Uv) -> f32| {
+        (l * stride..(l + 1) * stride).max_by(|&a, &b| key(&leaf_uv[a]).total_cmp(&key(&leaf_uv[b]))).unwrap()
     };
     let corners: Vec<[usize; 3]> =
-        (0..layout.leaves.len()).map(|l| [pick(l, &|v| -v.v), pick(l, &|v| v.v), pick(l, &|v| v.u)]).collect();
+        (0..layout.leaves.len()).map(|l| [pick(l, &|v| -v[1]), pick(l, &|v| v[1]), pick(l, &|v| v[0])]).collect();
     // The per-leaf flutter attribute: swing and twist frequencies above 0, at most 12 Hz.
     let flutter = &rb.custom["LEAF_FLUTTER"];
     assert_eq!(flutter.len(), layout.leaf_vertex_count());
@@ -609,8 +608,9 @@ fn hierarchy_attributes_tangents_and_static_export_mean_what_the_docs_say() {
     }
     // Tangents: unit, orthogonal to the normal, handedness ±1.
     let m = layout.mesh(&t, &sylva_core::pose::Pose::rest(&t));
-    for (verts, idx) in [(&m.tubes, &layout.tube_indices), (&m.leaves, &layout.leaf_indices)] {
-        for (v, tg) in verts.iter().zip(tangents(verts, idx)) {
+    let (tube_uv, leaf_uv) = (layout.tube_uv(), layout.leaf_uv());
+    for (verts, uv, idx) in [(&m.tubes, &tube_uv, &layout.tube_indices), (&m.leaves, &leaf_uv, &layout.leaf_indices)] {
+        for (v, tg) in verts.iter().zip(tangents(verts, uv, idx)) {
             let tv = Vec3::new(tg[0], tg[1], tg[2]);
             assert!((tv.length() - 1.0).abs() < 1e-5);
             assert!(tv.dot(v.normal()).abs() < 1e-4);

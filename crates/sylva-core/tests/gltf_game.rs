@@ -443,14 +443,14 @@ fn mikktspace_tangents_follow_u_across_a_card_and_around_a_stem() {
     use sylva_core::mesh::RawVertex;
     // A card in the x–y plane facing +z, u along +x and v along +y: tangent +x, w +1
     // (the bitangent n × t = +y, along v).
-    let corner = |x: f32, y: f32| RawVertex::new(glam::Vec3::new(x, y, 0.0), glam::Vec3::Z, x, y);
-    let card = [corner(0.0, 0.0), corner(1.0, 0.0), corner(1.0, 1.0), corner(0.0, 1.0)];
-    for t in tangents(&card, &[0, 1, 2, 0, 2, 3]) {
+    let corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let card = corners.map(|[x, y]| RawVertex::new(glam::Vec3::new(x, y, 0.0), glam::Vec3::Z));
+    for t in tangents(&card, &corners, &[0, 1, 2, 0, 2, 3]) {
         assert!(Vec3::from_slice(&t[..3]).distance(Vec3::X) < 1e-6 && t[3] == 1.0, "{t:?}");
     }
     // Mirrored in u: the tangent flips with the texture, the handedness too.
-    let mirrored: Vec<RawVertex> = card.iter().map(|c| RawVertex { u: 1.0 - c.u, ..*c }).collect();
-    for t in tangents(&mirrored, &[0, 1, 2, 0, 2, 3]) {
+    let mirrored = corners.map(|[u, v]| [1.0 - u, v]);
+    for t in tangents(&card, &mirrored, &[0, 1, 2, 0, 2, 3]) {
         assert!(Vec3::from_slice(&t[..3]).distance(-Vec3::X) < 1e-6 && t[3] == -1.0, "{t:?}");
     }
     // A game export's bark: u runs around the stem, so tangents lie across its axis.
@@ -460,7 +460,7 @@ fn mikktspace_tangents_follow_u_across_a_card_and_around_a_stem() {
     let n =
         (t.stems.segment_count[0] as usize * layout.params.samples as usize + 1) * (layout.params.sides as usize + 1);
     let axis = (t.segments.end(t.stems.segment_count[0] as usize - 1) - t.segments.start[0]).normalize();
-    let tg = tangents(&rest.tubes, &layout.tube_indices);
+    let tg = tangents(&rest.tubes, &layout.tube_uv(), &layout.tube_indices);
     let worst = tg[..n].iter().map(|g| Vec3::from_slice(&g[..3]).dot(axis).abs()).fold(0.0, f32::max);
     assert!(worst < 0.2, "a trunk tangent leans {worst} along the trunk");
 }

@@ -44,10 +44,13 @@ fn check_mesh(t: &Tree, pose: &Pose, layout: &MeshLayout, m: &MeshFrame, what: &
         assert!((n.length() - 1.0).abs() < 1e-4, "{what}: vertex {i} normal length {}", n.length());
     }
     // The seam column duplicates the first: same position and normal, u = 1 vs 0.
+    let uv = layout.tube_uv();
+    assert_eq!(uv.len(), layout.tube_vertex_count());
     for r in 0..layout.rings.len() {
         let (a, b) = (&m.tubes[r * stride], &m.tubes[r * stride + sides]);
         assert_eq!(a.position, b.position, "{what}: ring {r} seam open");
-        assert_eq!((a.u, b.u), (0.0, 1.0));
+        assert_eq!(a.normal_oct, b.normal_oct, "{what}: ring {r} seam's normals");
+        assert_eq!((uv[r * stride][0], uv[r * stride + sides][0]), (0.0, 1.0));
     }
     // Rings at joints: the ring shared by two segments is centred on the posed joint, which
     // is where the previous segment's tube ends (its posed end point).
@@ -151,6 +154,7 @@ fn leaves_hang_where_their_points_are_and_move_with_their_segment() {
     let l = MeshLayout::new(&t, MeshParams::default()).unwrap();
     let stride = l.params.leaf_sides as usize + 1;
     let rest = l.mesh(&t, &Pose::rest(&t));
+    let leaf_uv = l.leaf_uv();
     for i in (0..t.leaves.len()).step_by(97) {
         let c = pos(&rest.leaves[i * stride]);
         let want = t.leaves.position[i] + t.leaves.orientation[i] * Vec3::new(0.0, 0.5 * t.leaves.length[i], 0.0);
@@ -159,8 +163,9 @@ fn leaves_hang_where_their_points_are_and_move_with_their_segment() {
         // attachment point (the disc's half-circles hold its blade, so they start a little
         // below it).
         let r = &rest.leaves[i * stride + 1];
-        assert!((r.u - 0.5).abs() < 1e-6 && r.v < 0.0 && r.v > -0.1, "leaf {i} rim start ({}, {})", r.u, r.v);
-        let attach = c + (pos(r) - c) * (0.5 / (0.5 - r.v));
+        let [u, v] = leaf_uv[i * stride + 1];
+        assert!((u - 0.5).abs() < 1e-6 && v < 0.0 && v > -0.1, "leaf {i} rim start ({u}, {v})");
+        let attach = c + (pos(r) - c) * (0.5 / (0.5 - v));
         assert!((attach - t.leaves.position[i]).length() < 1e-5, "leaf {i} attachment");
         let n = rest.leaves[i * stride].normal();
         // Within the octahedral normal's quantisation (under 1e-4, `mesh::vertex`).

@@ -86,9 +86,9 @@ pub const LEAF_WIND: &str = include_str!("leaves/leaf_wind.wgsl");
 pub const LEAF_FLUTTER: &str = include_str!("leaves/leaf_flutter.wgsl");
 /// Kernel: seam rotations from HSM's clusters.
 pub const HSM_POSE: &str = include_str!("methods/hsm/hsm_pose.wgsl");
-/// The 24-byte output vertex (`Vertex`, octahedral normals), twin of `sylva_core::mesh::RawVertex`.
+/// The 16-byte output vertex (`Vertex`, octahedral normals), twin of `sylva_core::mesh::RawVertex`.
 pub const VERTEX: &str = include_str!("mesh/vertex.wgsl");
-/// Coalesced output of runs of vertices through workgroup memory (`put_vertex`, `flush_stage`).
+/// Coalesced output of runs of vertices through workgroup memory (`put_vertex`, `flush_runs`).
 pub const VERTEX_STAGE: &str = include_str!("mesh/vertex_stage.wgsl");
 /// Per-frame meshing structs (`Ring`, `MeshInfo`, `Detail`) and the bark relief.
 pub const MESH: &str = include_str!("mesh/mesh.wgsl");

@@ -517,12 +517,7 @@ fn mesh_structs_match_their_wgsl_twins() {
         &src,
         "Vertex",
         size_of::<RawVertex>(),
-        &[
-            ("position", offset_of!(RawVertex, position)),
-            ("normal_oct", offset_of!(RawVertex, normal_oct)),
-            ("u", offset_of!(RawVertex, u)),
-            ("v", offset_of!(RawVertex, v)),
-        ],
+        &[("position", offset_of!(RawVertex, position)), ("normal_oct", offset_of!(RawVertex, normal_oct))],
     );
 }
 

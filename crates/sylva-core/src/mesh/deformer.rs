@@ -229,6 +229,13 @@ impl DeformLayout {
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }
+
+    /// Texture coordinates, one per vertex (the static stream beside the deformed vertices):
+    /// `u` around the ring (the seam column at 1), `v` the ring's [`RawDeformRing::tex_v`].
+    pub fn uv(&self) -> Vec<super::Uv> {
+        let sides = self.params.sides;
+        self.rings.iter().flat_map(|r| (0..=sides).map(move |c| [c as f32 / sides as f32, r.tex_v])).collect()
+    }
 }
 
 /// The unbent branch's radius and its derivatives in v and θ at (v, θ) (eqs. 2–5).

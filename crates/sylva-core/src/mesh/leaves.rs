@@ -44,7 +44,7 @@ pub fn mesh_leaves(
             // tip and back, scaled to width and length.
             let uv = if k > 0 { rim[k - 1] } else { (0.5, 0.5) };
             let p = base + qx * ((uv.0 - 0.5) * lf.width) + qy * (uv.1 * lf.length);
-            *v = RawVertex::new(p, normal, uv.0, uv.1);
+            *v = RawVertex::new(p, normal);
         }
     });
 }

@@ -47,6 +47,7 @@ pub mod skin;
 mod skin_vertices;
 mod skjermo_deform;
 mod tubes;
+mod uv;
 mod vertex;
 
 pub use deformer::{DeformLayout, DeformerParams, RawDeformRing, RawDeformShape, deform_radius};
@@ -56,7 +57,7 @@ pub use skin::{RawSkin, RawSkinInfo, SkinLayout};
 pub use skin_vertices::skin_vertices;
 pub use skjermo_deform::skjermo_deform;
 pub use tubes::mesh_tubes;
-pub use vertex::{RawVertex, oct_decode, oct_encode};
+pub use vertex::{RawVertex, Uv, oct_decode, oct_encode};
 
 use crate::model::{NONE, RawLeaf, RawSegment, Tree};
 use crate::pose::Pose;
@@ -237,7 +238,7 @@ pub enum MeshError {
 }
 
 /// Largest number of vertices of one mesh (tubes or leaves): indices are u32 and a GPU
-/// storage binding holds 128 MiB on the smallest device Sylva supports (4 Mi × 24 B fits).
+/// storage binding holds 128 MiB on the smallest device Sylva supports (4 Mi × 16 B fits).
 pub const MAX_VERTICES: u64 = 4 << 20;
 
 impl MeshLayout {
@@ -572,7 +573,7 @@ impl MeshLayout {
         let mut tubes = vec![RawVertex::zeroed(); self.tube_vertex_count()];
         let ring_vertices = self.rings.len() * (self.params.sides as usize + 1);
         crate::mesh::mesh_tubes(&info, &self.rings, &self.segments, joint, acc, &mut tubes[..ring_vertices]);
-        crate::mesh::mesh_detail(&info, &self.details, &mut tubes);
+        crate::mesh::mesh_detail(&info, &self.details, &mut tubes, &self.rings);
         let mut leaves = vec![RawVertex::zeroed(); self.leaf_vertex_count()];
         crate::mesh::mesh_leaves(&info, &self.leaves, &self.segments, joint, acc, leaf_rotation, &mut leaves);
         MeshFrame { tubes, leaves }

@@ -51,6 +51,6 @@ pub fn skin_vertices(
         let w = s.weight;
         let p = (j0 + d0 * (x - r0)) * (1.0 - w) + (j1 + d1 * (x - r1)) * w;
         let normal = ((d0 * nrm) * (1.0 - w) + (d1 * nrm) * w).normalize();
-        *o = RawVertex::new(p, normal, rest[v].u, rest[v].v);
+        *o = RawVertex::new(p, normal);
     });
 }

@@ -69,7 +69,7 @@ pub fn skjermo_deform(
             // Scale-free: a twig tens of micrometres thick still has a well-defined normal.
             let (a, b) = (d_theta * (1.0 / d_theta.length().max(1e-30)), d_u * (1.0 / d_u.length().max(1e-30)));
             let normal = unit_or(a.cross(b), s0);
-            *v = RawVertex::new(pos, normal, c as f32 / info.sides as f32, rg.tex_v);
+            *v = RawVertex::new(pos, normal);
         }
     });
 }

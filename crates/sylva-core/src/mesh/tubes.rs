@@ -71,7 +71,7 @@ pub fn mesh_tubes(
                 let around = kk as f32 / info.sides as f32;
                 p += normal * (rg.relief * radius * bark_relief(around, rg.v, rg.stem_seed));
             }
-            *v = RawVertex::new(p, normal, k as f32 / info.sides as f32, rg.v);
+            *v = RawVertex::new(p, normal);
         }
     });
 }

@@ -1,18 +1,25 @@
-//! The vertex every mesh kernel writes and the renderer draws as it is: 24 bytes.
+//! The vertex every mesh kernel writes each frame and the renderer draws as it is: 16 bytes.
 //!
 //! - **Position**, three f32: world space over a 40 m tree needs millimetres at the top.
 //! - **Normal**, octahedral in two snorm16 (Cigolle et al. 2014, "A Survey of Efficient
 //!   Representations for Independent Unit Vectors", JCGT 3(2)): the unit sphere folded onto
 //!   the square, under 1e-4 rad of error (tested); the renderer reads it as `Snorm16x2`.
-//! - **uv**, two f32: bark `v` runs to ~100 along a thin stem (rest arc length over the base
-//!   circumference), where f16 would step by 1/16 of the texture.
+//!
+//! Texture coordinates do not move with the pose, so they are not written per frame: they
+//! are a second, static stream of [`Uv`] made once per layout ([`crate::mesh::MeshLayout::tube_uv`],
+//! `leaf_uv`, [`crate::mesh::DeformLayout::uv`]), which the renderer binds beside the
+//! vertices. They stay f32: bark `v` runs to ~100 along a thin stem (rest arc length over the
+//! base circumference), where f16 would step by 1/16 of the texture.
 //!
 //! The WGSL twins are `Vertex`, `oct_encode` and `oct_decode` in `mesh/vertex.wgsl`.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
-/// One output vertex, 24 bytes. WGSL: `struct Vertex` in `vertex.wgsl`.
+/// Texture coordinates (u, v) of a vertex, in the static stream beside [`RawVertex`].
+pub type Uv = [f32; 2];
+
+/// One output vertex, 16 bytes. WGSL: `struct Vertex` in `vertex.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawVertex {
@@ -21,17 +28,13 @@ pub struct RawVertex {
     /// Unit normal, octahedral: x in the low 16 bits, y in the high, each snorm16
     /// ([`oct_encode`]; [`RawVertex::normal`] decodes it).
     pub normal_oct: u32,
-    /// Texture coordinate u.
-    pub u: f32,
-    /// Texture coordinate v.
-    pub v: f32,
 }
 
 impl RawVertex {
-    /// A vertex at `position` with unit `normal` and texture coordinates `(u, v)`.
+    /// A vertex at `position` with unit `normal`.
     #[inline]
-    pub fn new(position: Vec3, normal: Vec3, u: f32, v: f32) -> Self {
-        Self { position: position.to_array(), normal_oct: oct_encode(normal), u, v }
+    pub fn new(position: Vec3, normal: Vec3) -> Self {
+        Self { position: position.to_array(), normal_oct: oct_encode(normal) }
     }
 
     /// The position.
@@ -106,7 +109,7 @@ mod tests {
     }
 
     #[test]
-    fn a_vertex_is_24_bytes() {
-        assert_eq!(std::mem::size_of::<RawVertex>(), 24);
+    fn a_vertex_is_16_bytes() {
+        assert_eq!(std::mem::size_of::<RawVertex>(), 16);
     }
 }

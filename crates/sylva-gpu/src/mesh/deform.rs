@@ -4,7 +4,7 @@
 //! are uploaded from the CPU ([`sylva_core::pose::Curves`]).
 
 use crate::kernel::{Kernel, output, read_back, upload};
-use crate::mesh::{index_buffer, vertex_buffer};
+use crate::mesh::{index_buffer, uv_buffer, vertex_buffer};
 use crate::render::MeshBuffers;
 use crate::{GpuContext, GpuError};
 use std::sync::Arc;
@@ -22,6 +22,7 @@ pub struct GpuDeform {
     stems: wgpu::Buffer,
     state: wgpu::Buffer,
     vertices: wgpu::Buffer,
+    uv: wgpu::Buffer,
     indices: wgpu::Buffer,
     index_count: u32,
     vertex_count: usize,
@@ -40,6 +41,7 @@ impl GpuDeform {
             stems: upload(ctx, "deform stems", stems)?,
             state: output::<RawSkjermoState>(ctx, "deform state", stems.len())?,
             vertices: vertex_buffer(ctx, "deformed bark", layout.vertex_count())?,
+            uv: uv_buffer(ctx, "deformed bark uv", &layout.uv()),
             indices: index_buffer(ctx, "deformed bark indices", &layout.indices),
             index_count: layout.indices.len() as u32,
             vertex_count: layout.vertex_count(),
@@ -94,6 +96,7 @@ impl GpuDeform {
     pub fn bark(&self) -> MeshBuffers<'_> {
         MeshBuffers {
             vertices: &self.vertices,
+            uv: &self.uv,
             indices: &self.indices,
             index_count: self.index_count,
             per_instance_vertices: 0,

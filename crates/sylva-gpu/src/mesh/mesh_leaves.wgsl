@@ -18,15 +18,14 @@ fn main(
     @builtin(local_invocation_index) lane: u32,
     @builtin(num_workgroups) nwg: vec3<u32>,
 ) {
-    let first = (wid.x + wid.y * nwg.x) * 64u;
+    let first = workgroup_first(wid, nwg);
     let stride = info.leaf_sides + 1u;
     let staged = stage_fits(stride);
     let l = first + lane;
     if (l < info.leaves) {
         leaf_vertices(l, lane, stride, staged);
     }
-    let count = select(0u, min(64u, info.leaves - first), first < info.leaves);
-    flush_stage(staged, first * stride, count * stride, lane);
+    flush_runs(staged, first, info.leaves, stride, lane);
 }
 
 fn leaf_vertices(l: u32, lane: u32, stride: u32, staged: bool) {
@@ -53,6 +52,6 @@ fn leaf_vertices(l: u32, lane: u32, stride: u32, staged: bool) {
             uv = leaf_rim(lf.shape, k - 1u, info.leaf_sides);
         }
         let p = base + qx * ((uv.x - 0.5) * lf.width) + qy * (uv.y * lf.length);
-        put_vertex(staged, lane * stride + k, l * stride + k, vertex_new(p, normal, uv.x, uv.y));
+        put_vertex(staged, lane * stride + k, l * stride + k, vertex_new(p, normal));
     }
 }

@@ -21,15 +21,14 @@ fn main(
     @builtin(local_invocation_index) lane: u32,
     @builtin(num_workgroups) nwg: vec3<u32>,
 ) {
-    let first = (wid.x + wid.y * nwg.x) * 64u;
+    let first = workgroup_first(wid, nwg);
     let stride = info.sides + 1u;
     let staged = stage_fits(stride);
     let r = first + lane;
     if (r < info.rings) {
         ring_vertices(r, lane, stride, staged);
     }
-    let count = select(0u, min(64u, info.rings - first), first < info.rings);
-    flush_stage(staged, first * stride, count * stride, lane);
+    flush_runs(staged, first, info.rings, stride, lane);
 }
 
 fn ring_vertices(r: u32, lane: u32, stride: u32, staged: bool) {
@@ -78,6 +77,6 @@ fn ring_vertices(r: u32, lane: u32, stride: u32, staged: bool) {
         if (rg.relief != 0.0) {
             p += normal * (rg.relief * radius * bark_relief(around, rg.v, rg.stem_seed));
         }
-        put_vertex(staged, lane * stride + k, r * stride + k, vertex_new(p, normal, f32(k) / f32(info.sides), rg.v));
+        put_vertex(staged, lane * stride + k, r * stride + k, vertex_new(p, normal));
     }
 }

@@ -12,7 +12,7 @@ use crate::kernel::{Kernel, Plan, PlanCache, output, read_back, upload};
 use crate::{GpuContext, GpuError};
 use std::sync::Arc;
 use sylva_core::Tree;
-use sylva_core::mesh::{MeshFrame, MeshLayout, RawVertex};
+use sylva_core::mesh::{MeshFrame, MeshLayout, RawVertex, Uv};
 use sylva_core::pose::Pose;
 use sylva_core::pose::{SeamPose, pose_buffers};
 use wgpu::util::DeviceExt;
@@ -39,6 +39,10 @@ pub struct GpuMesh {
     pub tube_indices: wgpu::Buffer,
     /// Leaf vertices (storage + vertex buffer).
     pub leaf_vertices: wgpu::Buffer,
+    /// Bark texture coordinates (static vertex buffer, [`MeshLayout::tube_uv`]).
+    pub tube_uv: wgpu::Buffer,
+    /// Leaf texture coordinates (static vertex buffer, [`MeshLayout::leaf_uv`]).
+    pub leaf_uv: wgpu::Buffer,
     /// Leaf triangle indices.
     pub leaf_indices: wgpu::Buffer,
     /// Number of bark indices.
@@ -69,6 +73,19 @@ pub(crate) fn vertex_buffer(ctx: &GpuContext, label: &'static str, len: usize) -
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     }))
+}
+
+/// A static vertex buffer of texture coordinates (the second stream beside the vertices).
+pub(crate) fn uv_buffer(ctx: &GpuContext, label: &'static str, uv: &[Uv]) -> wgpu::Buffer {
+    let mut data = uv.to_vec();
+    if data.is_empty() {
+        data.push([0.0; 2]);
+    }
+    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(&data),
+        usage: wgpu::BufferUsages::VERTEX,
+    })
 }
 
 pub(crate) fn index_buffer(ctx: &GpuContext, label: &'static str, indices: &[u32]) -> wgpu::Buffer {
@@ -107,6 +124,8 @@ impl GpuMesh {
             tube_indices: index_buffer(ctx, "tube indices", &layout.tube_indices),
             leaf_vertices: vertex_buffer(ctx, "leaf vertices", layout.leaf_vertex_count())?,
             leaf_indices: index_buffer(ctx, "leaf indices", &layout.leaf_indices),
+            tube_uv: uv_buffer(ctx, "tube uv", &layout.tube_uv()),
+            leaf_uv: uv_buffer(ctx, "leaf uv", &layout.leaf_uv()),
             tube_index_count: layout.tube_indices.len() as u32,
             leaf_index_count: layout.leaf_indices.len() as u32,
             tube_vertex_count: layout.tube_vertex_count(),
@@ -152,7 +171,7 @@ impl GpuMesh {
                 plan.push(ctx, &self.tubes, &buffers, self.ring_count as u32);
             }
             if self.detail_count > 0 {
-                let buffers = [&self.info, &self.details, &self.tube_vertices];
+                let buffers = [&self.info, &self.details, &self.tube_vertices, &self.rings];
                 plan.push(ctx, &self.detail_kernel, &buffers, self.detail_count as u32);
             }
             if self.leaf_count > 0 {
@@ -202,15 +221,16 @@ impl GpuMesh {
 
     /// What the renderer draws: this mesh once per instance of `instances`.
     pub fn draw_item<'a>(&'a self, instances: &'a wgpu::Buffer, instance_count: u32) -> crate::render::DrawItem<'a> {
-        let buffers = |vertices, indices, index_count| crate::render::MeshBuffers {
+        let buffers = |vertices, uv, indices, index_count| crate::render::MeshBuffers {
             vertices,
+            uv,
             indices,
             index_count,
             per_instance_vertices: 0,
         };
         crate::render::DrawItem {
-            bark: buffers(&self.tube_vertices, &self.tube_indices, self.tube_index_count),
-            leaves: buffers(&self.leaf_vertices, &self.leaf_indices, self.leaf_index_count),
+            bark: buffers(&self.tube_vertices, &self.tube_uv, &self.tube_indices, self.tube_index_count),
+            leaves: buffers(&self.leaf_vertices, &self.leaf_uv, &self.leaf_indices, self.leaf_index_count),
             instances,
             first_instance: 0,
             instance_count,

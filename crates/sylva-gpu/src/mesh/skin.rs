@@ -2,14 +2,16 @@
 //! `skin_vertices.wgsl` into instance-major vertex buffers the renderer draws as they are.
 
 use crate::kernel::{Kernel, Plan, PlanCache, read_back, upload};
-use crate::mesh::{index_buffer, vertex_buffer};
+use crate::mesh::{index_buffer, uv_buffer, vertex_buffer};
 use crate::render::{DrawItem, MeshBuffers};
 use crate::{GpuContext, GpuError};
 use std::sync::Arc;
-use sylva_core::mesh::{MeshFrame, MeshLayout, RawSkinInfo, RawVertex, SkinLayout};
+use sylva_core::mesh::{MeshFrame, MeshLayout, RawSkinInfo, RawVertex, SkinLayout, Uv};
 
 struct Part {
     rest: wgpu::Buffer,
+    /// Texture coordinates of one instance's vertices (every instance's).
+    uv: wgpu::Buffer,
     skin: wgpu::Buffer,
     indices: wgpu::Buffer,
     index_count: u32,
@@ -72,17 +74,18 @@ impl GpuSkin {
         max_batch: u32,
     ) -> Result<Self, GpuError> {
         let instances = instances.max(1);
-        let part = |rest: &[RawVertex], weights, indices: &[u32]| -> Result<Part, GpuError> {
+        let part = |rest: &[RawVertex], uv: &[Uv], weights, indices: &[u32]| -> Result<Part, GpuError> {
             Ok(Part {
                 rest: upload(ctx, "skin rest", rest)?,
+                uv: uv_buffer(ctx, "skin uv", uv),
                 skin: upload(ctx, "skin weights", weights)?,
                 indices: index_buffer(ctx, "skin indices", indices),
                 index_count: indices.len() as u32,
                 vertices: rest.len(),
             })
         };
-        let tubes = part(&skin.tube_rest, &skin.tube_skin, &layout.tube_indices)?;
-        let leaves = part(&skin.leaf_rest, &skin.leaf_skin, &layout.leaf_indices)?;
+        let tubes = part(&skin.tube_rest, &layout.tube_uv(), &skin.tube_skin, &layout.tube_indices)?;
+        let leaves = part(&skin.leaf_rest, &layout.leaf_uv(), &skin.leaf_skin, &layout.leaf_indices)?;
         let limits = ctx.device.limits();
         let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         let per_instance = (tubes.vertices.max(leaves.vertices).max(1) * std::mem::size_of::<RawVertex>()) as u64;
@@ -193,6 +196,7 @@ impl GpuSkin {
             .map(|b| {
                 let part = |p: &'a Part, out: &'a wgpu::Buffer| MeshBuffers {
                     vertices: out,
+                    uv: &p.uv,
                     indices: &p.indices,
                     index_count: p.index_count,
                     per_instance_vertices: p.vertices as u32,

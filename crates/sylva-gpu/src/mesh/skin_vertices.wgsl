@@ -53,5 +53,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let p1 = joint[base + s.bone1].xyz + quat_rotate(acc[base + s.bone1], x - rest_joint[s.bone1].xyz);
     let p = p0 * (1.0 - w) + p1 * w;
     let normal = normalize(quat_rotate(acc[base + s.bone0], nrm) * (1.0 - w) + quat_rotate(acc[base + s.bone1], nrm) * w);
-    out[id] = vertex_new(p, normal, rest[v].u, rest[v].v);
+    out[id] = vertex_new(p, normal);
 }

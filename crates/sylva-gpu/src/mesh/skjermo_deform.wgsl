@@ -70,15 +70,14 @@ fn main(
     @builtin(local_invocation_index) lane: u32,
     @builtin(num_workgroups) nwg: vec3<u32>,
 ) {
-    let first = (wid.x + wid.y * nwg.x) * 64u;
+    let first = workgroup_first(wid, nwg);
     let stride = info.sides + 1u;
     let staged = stage_fits(stride);
     let r_index = first + lane;
     if (r_index < info.rings) {
         ring_vertices(r_index, lane, stride, staged);
     }
-    let count = select(0u, min(64u, info.rings - first), first < info.rings);
-    flush_stage(staged, first * stride, count * stride, lane);
+    flush_runs(staged, first, info.rings, stride, lane);
 }
 
 fn ring_vertices(r_index: u32, lane: u32, stride: u32, staged: bool) {
@@ -133,7 +132,7 @@ fn ring_vertices(r_index: u32, lane: u32, stride: u32, staged: bool) {
         let a = d_theta * (1.0 / max(length(d_theta), 1e-30));
         let b = d_u * (1.0 / max(length(d_u), 1e-30));
         let normal = unit_or(cross(a, b), s0);
-        let x = vertex_new(pos, normal, f32(ci) / f32(info.sides), rg.tex_v);
+        let x = vertex_new(pos, normal);
         put_vertex(staged, lane * stride + ci, r_index * stride + ci, x);
     }
 }

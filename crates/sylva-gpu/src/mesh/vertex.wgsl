@@ -1,16 +1,14 @@
-// The vertex every mesh kernel writes and the renderer draws, 24 bytes (CPU twin:
-// sylva_core::mesh::RawVertex): position as three f32, the unit normal octahedral in two
-// snorm16 (oct_encode, oct_decode), texture coordinates as f32.
+// The vertex every mesh kernel writes each frame and the renderer draws, 16 bytes (CPU
+// twin: sylva_core::mesh::RawVertex): position as three f32, the unit normal octahedral in
+// two snorm16 (oct_encode, oct_decode). Texture coordinates are a static second stream.
 
 struct Vertex {
     position: array<f32, 3>,
     normal_oct: u32,
-    u: f32,
-    v: f32,
 }
 
-fn vertex_new(p: vec3<f32>, n: vec3<f32>, u: f32, v: f32) -> Vertex {
-    return Vertex(array<f32, 3>(p.x, p.y, p.z), oct_encode(n), u, v);
+fn vertex_new(p: vec3<f32>, n: vec3<f32>) -> Vertex {
+    return Vertex(array<f32, 3>(p.x, p.y, p.z), oct_encode(n));
 }
 
 fn vertex_pos(x: Vertex) -> vec3<f32> {

@@ -4,11 +4,11 @@
 // so a store instruction covers consecutive words (one invocation writing its run alone
 // strides the warp's stores by the run's length). Where 64 runs do not fit the stage (rings
 // of more than 8 sides), vertices go straight out. The kernel declares
-// `vertex_words: array<u32>` (its `array<Vertex>`, six words a vertex).
+// `vertex_words: array<u32>` (its `array<Vertex>`, four words a vertex).
 
-const VERTEX_WORDS: u32 = 6u;
-// 64 invocations × 9 vertices × 6 words: 13.5 KiB of the 16 KiB WebGPU guarantees.
-const STAGE_WORDS: u32 = 3456u;
+const VERTEX_WORDS: u32 = 4u;
+// 64 invocations × 9 vertices × 4 words: 9 KiB of the 16 KiB WebGPU guarantees.
+const STAGE_WORDS: u32 = 2304u;
 
 var<workgroup> stage: array<u32, STAGE_WORDS>;
 
@@ -25,26 +25,29 @@ fn put_vertex(staged: bool, slot: u32, index: u32, x: Vertex) {
         stage[b + 1u] = bitcast<u32>(x.position[1]);
         stage[b + 2u] = bitcast<u32>(x.position[2]);
         stage[b + 3u] = x.normal_oct;
-        stage[b + 4u] = bitcast<u32>(x.u);
-        stage[b + 5u] = bitcast<u32>(x.v);
     } else {
         let b = index * VERTEX_WORDS;
         vertex_words[b] = bitcast<u32>(x.position[0]);
         vertex_words[b + 1u] = bitcast<u32>(x.position[1]);
         vertex_words[b + 2u] = bitcast<u32>(x.position[2]);
         vertex_words[b + 3u] = x.normal_oct;
-        vertex_words[b + 4u] = bitcast<u32>(x.u);
-        vertex_words[b + 5u] = bitcast<u32>(x.v);
     }
 }
 
-// After every invocation has put its run: the workgroup's `count` vertices from vertex
-// `first` of the buffer, written in consecutive words. Call from uniform control flow.
-fn flush_stage(staged: bool, first: u32, count: u32, lane: u32) {
+// The first item (ring, leaf) of a workgroup of 64 in a dispatch that may wrap into y.
+fn workgroup_first(wid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return (wid.x + wid.y * nwg.x) * 64u;
+}
+
+// After every invocation has put its run: the runs of the workgroup's items from `first`
+// (of `items` in all, `run` vertices each), written in consecutive words. Call from uniform
+// control flow.
+fn flush_runs(staged: bool, first: u32, items: u32, run: u32, lane: u32) {
     if (staged) {
         workgroupBarrier();
-        let words = count * VERTEX_WORDS;
-        let base = first * VERTEX_WORDS;
+        let count = select(0u, min(64u, items - first), first < items);
+        let words = count * run * VERTEX_WORDS;
+        let base = first * run * VERTEX_WORDS;
         for (var w = lane; w < words; w += 64u) {
             vertex_words[base + w] = stage[w];
         }

@@ -110,7 +110,7 @@ pub struct Instance {
 }
 
 /// GPU twin of [`Instance`], 80 bytes: four matrix columns and the tint (vertex attributes
-/// 3–7 of `render.wgsl`).
+/// 3–7 of `render.wgsl`, the third vertex buffer).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawInstance {
@@ -149,9 +149,12 @@ pub struct RawGlobals {
 /// Vertex and index buffers of one material.
 #[derive(Debug, Clone, Copy)]
 pub struct MeshBuffers<'a> {
-    /// Vertices ([`sylva_core::mesh::RawVertex`], 24 bytes: `Float32x3` position, `Snorm16x2`
-    /// octahedral normal, `Float32x2` uv), written by a mesh or skinning kernel.
+    /// Vertices ([`sylva_core::mesh::RawVertex`], 16 bytes: `Float32x3` position, `Snorm16x2`
+    /// octahedral normal), written by a mesh or skinning kernel.
     pub vertices: &'a wgpu::Buffer,
+    /// Texture coordinates ([`sylva_core::mesh::Uv`], `Float32x2`), one per vertex of one
+    /// instance, static.
+    pub uv: &'a wgpu::Buffer,
     /// Triangle indices.
     pub indices: &'a wgpu::Buffer,
     /// Number of indices.
@@ -208,9 +211,10 @@ pub enum RenderError {
     Setting { field: &'static str, value: String, expected: &'static str },
 }
 
-fn vertex_layouts() -> [Option<wgpu::VertexBufferLayout<'static>>; 2] {
-    // sylva_core::mesh::RawVertex: position, octahedral normal, uv.
-    const VERTEX: [wgpu::VertexAttribute; 3] = wgpu::vertex_attr_array![0 => Float32x3, 1 => Snorm16x2, 2 => Float32x2];
+fn vertex_layouts() -> [Option<wgpu::VertexBufferLayout<'static>>; 3] {
+    // sylva_core::mesh::RawVertex: position, octahedral normal; then the static uv stream.
+    const VERTEX: [wgpu::VertexAttribute; 2] = wgpu::vertex_attr_array![0 => Float32x3, 1 => Snorm16x2];
+    const UV: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![2 => Float32x2];
     const INSTANCE: [wgpu::VertexAttribute; 5] =
         wgpu::vertex_attr_array![3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4];
     [
@@ -218,6 +222,11 @@ fn vertex_layouts() -> [Option<wgpu::VertexBufferLayout<'static>>; 2] {
             array_stride: std::mem::size_of::<sylva_core::mesh::RawVertex>() as u64,
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &VERTEX,
+        }),
+        Some(wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<sylva_core::mesh::Uv>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &UV,
         }),
         Some(wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<RawInstance>() as u64,
@@ -542,16 +551,21 @@ impl Renderer {
                 if m.index_count == 0 || item.instance_count == 0 {
                     continue;
                 }
-                pass.set_vertex_buffer(0, m.vertices.slice(..));
-                pass.set_vertex_buffer(1, item.instances.slice(..));
+                pass.set_vertex_buffer(1, m.uv.slice(..));
+                pass.set_vertex_buffer(2, item.instances.slice(..));
                 pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
                 let first = item.first_instance;
                 if m.per_instance_vertices == 0 {
+                    pass.set_vertex_buffer(0, m.vertices.slice(..));
                     pass.draw_indexed(0..m.index_count, 0, first..first + item.instance_count);
                 } else {
+                    // Instance k's vertices from k × n on, its texture coordinates the
+                    // shared ones: the vertex stream bound from there.
+                    let stride = std::mem::size_of::<sylva_core::mesh::RawVertex>() as u64;
+                    let n = m.per_instance_vertices as u64;
                     for k in 0..item.instance_count {
-                        let base = (k * m.per_instance_vertices) as i32;
-                        pass.draw_indexed(0..m.index_count, base, first + k..first + k + 1);
+                        pass.set_vertex_buffer(0, m.vertices.slice(k as u64 * n * stride..(k as u64 + 1) * n * stride));
+                        pass.draw_indexed(0..m.index_count, 0, first + k..first + k + 1);
                     }
                 }
             }

@@ -134,7 +134,8 @@ fn fs_ground(v: GroundOut) -> @location(0) vec4<f32> {
 
 // ---- trees: bark and leaves from the mesh kernels' vertex buffers, instanced ----------------
 
-// sylva_core::mesh::RawVertex (vertex.wgsl, composed before this file), then the instance.
+// sylva_core::mesh::RawVertex (vertex.wgsl, composed before this file), the static uv
+// stream, then the instance.
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal_oct: vec2<f32>,

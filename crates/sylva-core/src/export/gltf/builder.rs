@@ -234,18 +234,18 @@ impl Builder {
         };
         attributes.insert(Valid(Semantic::Normals), normal);
         attributes.insert(Valid(Semantic::Tangents), tangent);
-        let in_unit = v.iter().all(|x| (0.0..=1.0).contains(&x.u) && (0.0..=1.0).contains(&x.v));
+        let in_unit = g.uv.iter().all(|x| (0.0..=1.0).contains(&x[0]) && (0.0..=1.0).contains(&x[1]));
         let uv = if fmt.quantize && in_unit {
-            let uv: Vec<u16> = v.iter().flat_map(|x| [unorm16(x.u), unorm16(x.v)]).collect();
+            let uv: Vec<u16> = g.uv.iter().flat_map(|x| x.map(unorm16)).collect();
             self.ints(&uv, Vec2, U16, true)
         } else {
-            let uv: Vec<f32> = v.iter().flat_map(|x| [x.u, x.v]).collect();
+            let uv: Vec<f32> = g.uv.iter().flatten().copied().collect();
             self.floats(&uv, Vec2, true)
         };
         attributes.insert(Valid(Semantic::TexCoords(0)), uv);
         if fmt.skinned {
             let (joints, weights): (Vec<[u16; 4]>, Vec<[f32; 4]>) =
-                g.skin.iter().zip(v).map(|(s, x)| rig.bind(s, x.v)).unzip();
+                g.skin.iter().zip(g.uv).map(|(s, x)| rig.bind(s, x[1])).unzip();
             let (j, w) = if fmt.quantize {
                 let weights: Vec<[u8; 4]> = weights.iter().map(|w| weights_u8(*w)).collect();
                 // A weight that rounds to zero leaves its joint unused: glTF wants it 0 too.

@@ -12,8 +12,9 @@ pub(super) const CARD_VERTICES: usize = 4;
 /// area a thinned leaf stands for, see [`MeshLayout::thin_leaves`]): its four blades of half
 /// that side carry the kept leaf's area. The bottom edge's midpoint is the leaf's attachment,
 /// the card turns in the leaf's rest frame, and `v` runs from the attachment (0) to the top.
-pub(super) fn cards(leaves: &[RawLeaf]) -> (Vec<RawVertex>, Vec<RawSkin>, Vec<u32>) {
+pub(super) fn cards(leaves: &[RawLeaf]) -> (Vec<RawVertex>, Vec<Uv>, Vec<RawSkin>, Vec<u32>) {
     let mut vertices = Vec::with_capacity(leaves.len() * CARD_VERTICES);
+    let mut uv = Vec::with_capacity(leaves.len() * CARD_VERTICES);
     let mut skin = Vec::with_capacity(leaves.len() * CARD_VERTICES);
     let mut indices = Vec::with_capacity(leaves.len() * 6);
     for (k, l) in leaves.iter().enumerate() {
@@ -23,11 +24,12 @@ pub(super) fn cards(leaves: &[RawLeaf]) -> (Vec<RawVertex>, Vec<RawSkin>, Vec<u3
         let base = Vec3::from_array(l.position);
         for (u, v) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
             let p = base + x * ((u - 0.5) * side) + y * (v * side);
-            vertices.push(RawVertex::new(p, normal, u, v));
+            vertices.push(RawVertex::new(p, normal));
+            uv.push([u, v]);
             skin.push(RawSkin { bone0: l.segment, bone1: l.segment, weight: 0.0, leaf: l.index + 1 });
         }
         let c = (k * CARD_VERTICES) as u32;
         indices.extend_from_slice(&[c, c + 1, c + 2, c, c + 2, c + 3]);
     }
-    (vertices, skin, indices)
+    (vertices, uv, skin, indices)
 }

@@ -74,7 +74,7 @@ pub use target::{Budget, CARD_TRIANGLES, GAME_BUDGET, KEY_TOLERANCE_DEG, Target,
 use super::bake::Clip;
 use super::textures;
 use crate::io::write_atomic;
-use crate::mesh::{MeshError, MeshLayout, MeshParams, RawSkin, RawVertex, SkinLayout};
+use crate::mesh::{MeshError, MeshLayout, MeshParams, RawSkin, RawVertex, SkinLayout, Uv};
 use crate::model::{NONE, RawLeaf, Tree};
 use builder::{Builder, Format};
 use glam::{Mat4, Quat, Vec3, Vec4};
@@ -494,22 +494,23 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
         let mut primitives = Vec::new();
         let fmt = Format { skinned: clip.is_some(), quantize: opts.quantize, custom: opts.custom_attributes };
         let cards = if lod.cards { cards::cards(&layout.leaves) } else { Default::default() };
-        let (vertices, leaf_skin, indices, leaf_stride, leaf_material) = if lod.cards {
-            (&cards.0, &cards.1, &cards.2, cards::CARD_VERTICES, card_mat)
+        let (tube_uv, mesh_leaf_uv) = (layout.tube_uv(), layout.leaf_uv());
+        let (vertices, leaf_uv, leaf_skin, indices, leaf_stride, leaf_material) = if lod.cards {
+            (&cards.0, &cards.1, &cards.2, &cards.3, cards::CARD_VERTICES, card_mat)
         } else {
             let stride = layout.params.leaf_sides as usize + 1;
-            (&skinned.leaf_rest, &skinned.leaf_skin, &layout.leaf_indices, stride, leaf_mat)
+            (&skinned.leaf_rest, &mesh_leaf_uv, &skinned.leaf_skin, &layout.leaf_indices, stride, leaf_mat)
         };
         // Bark and leaves side by side: their tangents (MikkTSpace) are most of a level's cost.
         let (bark, leaves) = rayon::join(
             || {
-                Geometry::new(&skinned.tube_rest, &skinned.tube_skin, &layout.tube_indices, |_, s| {
+                Geometry::new(&skinned.tube_rest, &tube_uv, &skinned.tube_skin, &layout.tube_indices, |_, s| {
                     hier.bark(tree, s.bone0 as usize)
                 })
             },
             || {
                 (!layout.leaves.is_empty()).then(|| {
-                    let mut g = Geometry::new(vertices, leaf_skin, indices, |v, _| {
+                    let mut g = Geometry::new(vertices, leaf_uv, leaf_skin, indices, |v, _| {
                         hier.leaf(tree, &layout.leaves[v / leaf_stride])
                     });
                     g.flutter = (0..vertices.len())

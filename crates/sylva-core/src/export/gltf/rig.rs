@@ -252,6 +252,7 @@ pub(super) fn leaf_flutter(tree: &Tree) -> Vec<[f32; 3]> {
 /// One primitive's vertex streams.
 pub(super) struct Geometry<'a> {
     pub(super) vertices: &'a [RawVertex],
+    pub(super) uv: &'a [Uv],
     pub(super) skin: &'a [RawSkin],
     pub(super) indices: &'a [u32],
     pub(super) tangents: Vec<[f32; 4]>,
@@ -264,15 +265,17 @@ pub(super) struct Geometry<'a> {
 impl<'a> Geometry<'a> {
     pub(super) fn new(
         vertices: &'a [RawVertex],
+        uv: &'a [Uv],
         skin: &'a [RawSkin],
         indices: &'a [u32],
         element: impl Fn(usize, &RawSkin) -> Element,
     ) -> Self {
         Self {
             vertices,
+            uv,
             skin,
             indices,
-            tangents: tangents(vertices, indices),
+            tangents: tangents(vertices, uv, indices),
             elements: skin.iter().enumerate().map(|(v, s)| element(v, s)).collect(),
             flutter: Vec::new(),
         }
@@ -284,9 +287,10 @@ impl<'a> Geometry<'a> {
 /// normal map reads the same in every engine. A vertex shared by faces keeps the last face's
 /// tangent (MikkTSpace would split it only where the faces disagree); one MikkTSpace leaves
 /// without a value gets any tangent orthogonal to its normal.
-pub fn tangents(vertices: &[RawVertex], indices: &[u32]) -> Vec<[f32; 4]> {
+pub fn tangents(vertices: &[RawVertex], uv: &[Uv], indices: &[u32]) -> Vec<[f32; 4]> {
     struct Mesh<'a> {
         vertices: &'a [RawVertex],
+        uv: &'a [Uv],
         indices: &'a [u32],
         out: Vec<Option<[f32; 4]>>,
     }
@@ -309,8 +313,7 @@ pub fn tangents(vertices: &[RawVertex], indices: &[u32]) -> Vec<[f32; 4]> {
             self.at(face, vert).normal().to_array()
         }
         fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
-            let v = self.at(face, vert);
-            [v.u, v.v]
+            self.uv[self.indices[face * 3 + vert] as usize]
         }
         fn set_tangent(&mut self, t: Option<bevy_mikktspace::TangentSpace>, face: usize, vert: usize) {
             if let Some(t) = t {
@@ -318,7 +321,7 @@ pub fn tangents(vertices: &[RawVertex], indices: &[u32]) -> Vec<[f32; 4]> {
             }
         }
     }
-    let mut mesh = Mesh { vertices, indices, out: vec![None; vertices.len()] };
+    let mut mesh = Mesh { vertices, uv, indices, out: vec![None; vertices.len()] };
     // An error only means no face could be processed: every vertex takes the fallback.
     let _ = bevy_mikktspace::generate_tangents(&mut mesh);
     vertices
