@@ -54,6 +54,9 @@ pub struct AkagiRow {
     pub cpu_all_ms: Option<[f64; 3]>,
     /// GPU, ms per frame.
     pub gpu_ms: Option<[f64; 3]>,
+    /// GPU, ms per frame, each invocation writing its run of vertices directly instead of
+    /// the workgroup's runs together (`GpuMesh::set_staged(false)`).
+    pub gpu_direct_ms: Option<[f64; 3]>,
     /// The GPU's commands per frame.
     pub gpu_commands: Option<Commands>,
     /// CPU (all threads) bytes/s over the measured copy bandwidth.
@@ -165,22 +168,28 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         } else {
             (None, None)
         };
-        let (gpu, gpu_commands) = match ctx {
+        let (gpu, gpu_direct, gpu_commands) = match ctx {
             Some(c) => {
-                let mesh = sylva_gpu::mesh::GpuMesh::new(c, &layout)?;
+                let mut mesh = sylva_gpu::mesh::GpuMesh::new(c, &layout)?;
                 let jb = sylva_gpu::kernel::upload(c, "bench joints", &joint)?;
                 let ab = sylva_gpu::kernel::upload(c, "bench rotations", &acc)?;
-                let mut frames = |n| {
-                    let mut e = c.device.create_command_encoder(&Default::default());
-                    for _ in 0..n {
-                        mesh.record(c, &mut e, &jb, &ab);
-                    }
-                    c.submit([e.finish()]);
-                    Ok(())
+                let time = |mesh: &sylva_gpu::mesh::GpuMesh| -> Result<_> {
+                    let mut frames = |n| {
+                        let mut e = c.device.create_command_encoder(&Default::default());
+                        for _ in 0..n {
+                            mesh.record(c, &mut e, &jb, &ab);
+                        }
+                        c.submit([e.finish()]);
+                        Ok(())
+                    };
+                    Ok((measure_gpu(budget, c, &mut frames)?, count_gpu(c, &mut frames)?))
                 };
-                (Some(measure_gpu(budget, c, &mut frames)?), Some(count_gpu(c, &mut frames)?))
+                let (staged, commands) = time(&mesh)?;
+                mesh.set_staged(c, false);
+                let (direct, _) = time(&mesh)?;
+                (Some(staged), Some(direct), Some(commands))
             }
-            None => (None, None),
+            None => (None, None, None),
         };
         let row = AkagiRow {
             paper_triangles,
@@ -194,6 +203,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             cpu_one_ms: cpu_one.map(|r| r.ms()),
             cpu_all_ms: cpu_all.map(|r| r.ms()),
             gpu_ms: gpu.map(|r| r.ms()),
+            gpu_direct_ms: gpu_direct.map(|r| r.ms()),
             gpu_commands,
             cpu_bandwidth_fraction: cpu_all.map(|r| r.median * bytes as f64 / cpu_bw),
             gpu_bandwidth_fraction: gpu.zip(gpu_bw).map(|(r, b)| r.median * bytes as f64 / b),
@@ -218,17 +228,17 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     let mut md = markdown_head("Akagi & Kitajima Table 2: mesh regeneration per frame", "akagi-t2", env.machine);
     md += "ms per frame, median (min–max). The paper: Core2 QX9650 one thread, GeForce GTX 280, generation + drawing.\n\n";
     md += &format!(
-        "| paper triangles | paper CPU ms | paper GPU ms | paper CPU/GPU | triangles | trees | MB/frame | B/triangle | CPU 1 thread ms | CPU all threads ms | CPU % of bandwidth | GPU ms | GPU % of bandwidth | CPU 1 thread / GPU | CPU all / GPU | {} |\n",
+        "| paper triangles | paper CPU ms | paper GPU ms | paper CPU/GPU | triangles | trees | MB/frame | B/triangle | CPU 1 thread ms | CPU all threads ms | CPU % of bandwidth | GPU ms | GPU ms, runs direct | GPU % of bandwidth | CPU 1 thread / GPU | CPU all / GPU | {} |\n",
         COMMANDS_HEADING.replace("step", "frame")
     );
-    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let ratio = |a: Option<[f64; 3]>, b: Option<[f64; 3]>| match (a, b) {
         (Some(a), Some(b)) => format!("{:.1}", a[0] / b[0]),
         _ => "–".into(),
     };
     for r in &out {
         md += &format!(
-            "| {} | {:.2} | {:.3} | {:.0} | {} | {} | {:.1} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {:.2} | {:.3} | {:.0} | {} | {} | {:.1} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.paper_triangles,
             r.paper_cpu_ms,
             r.paper_gpu_ms,
@@ -241,6 +251,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             cell(r.cpu_all_ms),
             r.cpu_bandwidth_fraction.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f)),
             cell(r.gpu_ms),
+            cell(r.gpu_direct_ms),
             r.gpu_bandwidth_fraction.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f)),
             ratio(r.cpu_one_ms, r.gpu_ms),
             ratio(r.cpu_all_ms, r.gpu_ms),

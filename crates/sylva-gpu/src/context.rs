@@ -120,12 +120,14 @@ pub struct GpuContext {
     /// minimum and maximum agree, a power of two up to 64): kernels with a subgroup path use
     /// it ([`crate::methods::hsm::GpuHsm`]'s stage 1).
     pub subgroup_size: Option<u32>,
-    /// Compiled kernels by name: each is compiled once per context (see
-    /// [`crate::kernel::Kernel::cached`]).
-    pub(crate) kernels:
-        std::sync::Mutex<std::collections::HashMap<&'static str, std::sync::Arc<crate::kernel::Kernel>>>,
+    /// Compiled kernels by name and pipeline constants: each is compiled once per context
+    /// (see [`crate::kernel::Kernel::cached`]).
+    pub(crate) kernels: std::sync::Mutex<std::collections::HashMap<KernelKey, std::sync::Arc<crate::kernel::Kernel>>>,
     pub(crate) counters: Counters,
 }
+
+/// A compiled kernel's name and its pipeline constants (name, value bits).
+pub(crate) type KernelKey = (&'static str, Vec<(String, u64)>);
 
 impl GpuContext {
     /// Creates a context. The instance reads the environment (`WGPU_BACKEND=vulkan` makes a

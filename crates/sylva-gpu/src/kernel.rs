@@ -79,8 +79,9 @@ impl Kernel {
         sources: &[&str],
         constants: &[(&str, f64)],
     ) -> std::sync::Arc<Self> {
+        let key = (name, constants.iter().map(|(k, v)| (k.to_string(), v.to_bits())).collect());
         let mut map = ctx.kernels.lock().unwrap_or_else(|e| e.into_inner());
-        map.entry(name)
+        map.entry(key)
             .or_insert_with(|| std::sync::Arc::new(Self::with_constants(ctx, name, sources, constants)))
             .clone()
     }
@@ -92,8 +93,8 @@ impl Kernel {
     }
 
     /// [`Self::get`] for a kernel with pipeline-overridable constants: compiled with
-    /// `constants` on first use on this context, shared after (pass the same values on one
-    /// context, such as its [`GpuContext::subgroup_size`]).
+    /// `constants` on first use on this context, shared after (one pipeline per kernel and
+    /// set of values).
     pub fn get_with(ctx: &GpuContext, name: &str, constants: &[(&str, f64)]) -> std::sync::Arc<Self> {
         let def = crate::shaders::kernel(name).unwrap_or_else(|| panic!("no kernel `{name}` in shaders::KERNELS"));
         Self::cached_with(ctx, def.name, def.sources, constants)

@@ -285,3 +285,23 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
         assert!(d <= 1e-6, "normal {i}: decoded {:?} vs {:?}", decoded[i], oct_decode(cpu_bits[i]));
     }
 }
+
+/// The bark and leaf kernels write the same vertices bit for bit whether their runs go
+/// through workgroup memory or straight out (`GpuMesh::set_staged`), on a tree with partial
+/// workgroups of rings and leaves.
+#[test]
+fn staged_and_direct_runs_write_the_same_bits() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(2031);
+    let t = SpeciesSource::resolve("quaking_aspen").unwrap().generate(4, &Default::default(), None).unwrap();
+    let layout = MeshLayout::new(&t, MeshParams::default()).unwrap();
+    assert!(layout.rings.len() % 64 != 0 || layout.leaves.len() % 64 != 0, "a partial workgroup");
+    let pose = random_pose(&t, &mut rng);
+    let mut gpu = GpuMesh::new(ctx, &layout).unwrap();
+    assert!(gpu.staged());
+    let staged = gpu.mesh(ctx, &t, &pose).unwrap();
+    gpu.set_staged(ctx, false);
+    let direct = gpu.mesh(ctx, &t, &pose).unwrap();
+    assert!(staged.tubes == direct.tubes && staged.leaves == direct.leaves, "staged and direct runs differ");
+    compare(&t, &layout.mesh(&t, &pose), &staged, "staged");
+}

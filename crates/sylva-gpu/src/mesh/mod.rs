@@ -56,6 +56,7 @@ pub struct GpuMesh {
     leaf_count: usize,
     segment_count: usize,
     leaf_slots: usize,
+    staged: bool,
     /// The kernels bound to the last pose buffers meshed (a method's are the same every
     /// frame).
     plan: PlanCache,
@@ -100,7 +101,27 @@ pub(crate) fn index_buffer(ctx: &GpuContext, label: &'static str, indices: &[u32
     })
 }
 
+/// The bark or leaf kernel, its runs of vertices staged in workgroup memory or written
+/// directly (`STAGE_RUNS` in `vertex_stage.wgsl`).
+fn run_kernel(ctx: &GpuContext, name: &str, staged: bool) -> Arc<Kernel> {
+    if staged { Kernel::get(ctx, name) } else { Kernel::get_with(ctx, name, &[("STAGE_RUNS", 0.0)]) }
+}
+
 impl GpuMesh {
+    /// Whether the bark and leaf kernels write their runs through workgroup memory (the
+    /// default) or each invocation its own directly; the vertices are the same bit for bit.
+    pub fn set_staged(&mut self, ctx: &GpuContext, on: bool) {
+        self.tubes = run_kernel(ctx, "mesh_tubes", on);
+        self.leaves_kernel = run_kernel(ctx, "mesh_leaves", on);
+        self.staged = on;
+        self.plan = Default::default();
+    }
+
+    /// Whether runs are staged ([`Self::set_staged`]).
+    pub fn staged(&self) -> bool {
+        self.staged
+    }
+
     /// Uploads the topology of `layout`.
     pub fn new(ctx: &GpuContext, layout: &MeshLayout) -> Result<Self, GpuError> {
         let n = layout.segments.len();
@@ -135,6 +156,7 @@ impl GpuMesh {
             leaf_count: layout.leaves.len(),
             segment_count: n,
             leaf_slots: layout.leaf_slots as usize,
+            staged: true,
             plan: Default::default(),
         })
     }

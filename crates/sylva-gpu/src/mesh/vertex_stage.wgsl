@@ -3,7 +3,8 @@
 // invocations write them out together, word t of the workgroup's span by invocation t mod 64,
 // so a store instruction covers consecutive words (one invocation writing its run alone
 // strides the warp's stores by the run's length). Where 64 runs do not fit the stage (rings
-// of more than 8 sides), vertices go straight out. The kernel declares
+// of more than 8 sides), or with STAGE_RUNS off (GpuMesh::set_staged), vertices go straight
+// out. The kernel declares
 // `vertex_words: array<u32>` (its `array<Vertex>`, four words a vertex).
 
 const VERTEX_WORDS: u32 = 4u;
@@ -12,9 +13,13 @@ const STAGE_WORDS: u32 = 2304u;
 
 var<workgroup> stage: array<u32, STAGE_WORDS>;
 
-// Whether 64 runs of `run` vertices fit the stage (uniform: `run` comes from read-only data).
+// Set when the pipeline is made: false writes every run directly (to compare the two).
+override STAGE_RUNS: bool = true;
+
+// Whether to stage: on, and 64 runs of `run` vertices fit (uniform: `run` comes from
+// read-only data).
 fn stage_fits(run: u32) -> bool {
-    return run * 64u * VERTEX_WORDS <= STAGE_WORDS;
+    return STAGE_RUNS && run * 64u * VERTEX_WORDS <= STAGE_WORDS;
 }
 
 // Vertex `slot` of the workgroup's span into the stage, or vertex `index` of the buffer.
