@@ -4,8 +4,8 @@
 // so a store instruction covers consecutive words (one invocation writing its run alone
 // strides the warp's stores by the run's length). Where 64 runs do not fit the stage (rings
 // of more than 8 sides), or with STAGE_RUNS off (GpuMesh::set_staged), vertices go straight
-// out. The kernel declares
-// `vertex_words: array<u32>` (its `array<Vertex>`, four words a vertex).
+// out. The kernel declares `vertex_words: array<u32>` (its `array<Vertex>`, four words a
+// vertex).
 
 const VERTEX_WORDS: u32 = 4u;
 // 64 invocations × 9 vertices × 4 words: 9 KiB of the 16 KiB WebGPU guarantees.
