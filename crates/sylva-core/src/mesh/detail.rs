@@ -1,15 +1,9 @@
 //! CPU twin of `mesh_detail.wgsl`: one midpoint vertex of a subdivided band per work
 //! item (Akagi §2.3). See [`crate::mesh`] for the construction.
 
+use super::uv::ring_uv;
 use crate::mesh::{RawDetail, RawMeshInfo, RawRing, RawVertex, bark_relief};
 use rayon::prelude::*;
-
-/// Texture coordinates of ring vertex `a` (as [`crate::mesh::MeshLayout::tube_uv`] has them).
-#[inline]
-fn ring_uv(info: &RawMeshInfo, ring: &[RawRing], a: u32) -> (f32, f32) {
-    let stride = info.sides + 1;
-    ((a % stride) as f32 / info.sides as f32, ring[(a / stride) as usize].v)
-}
 
 /// Writes detail d's vertex `vertex[rings × (sides + 1) + d]` from the two ring vertices of
 /// its edge (written by `mesh_tubes` first): the edge's midpoint, the mean normal, and the
@@ -24,8 +18,8 @@ pub fn mesh_detail(info: &RawMeshInfo, detail: &[RawDetail], vertex: &mut [RawVe
         let mut p = (a.pos() + b.pos()) * 0.5;
         if d.scale != 0.0 {
             let (ua, ub) = (ring_uv(info, ring, d.a), ring_uv(info, ring, d.b));
-            let (u, vv) = (0.5 * (ua.0 + ub.0), 0.5 * (ua.1 + ub.1));
-            let ends = 0.5 * (bark_relief(ua.0, ua.1, d.stem_seed) + bark_relief(ub.0, ub.1, d.stem_seed));
+            let (u, vv) = (0.5 * (ua[0] + ub[0]), 0.5 * (ua[1] + ub[1]));
+            let ends = 0.5 * (bark_relief(ua[0], ua[1], d.stem_seed) + bark_relief(ub[0], ub[1], d.stem_seed));
             p += normal * (d.scale * (bark_relief(u, vv, d.stem_seed) - ends));
         }
         *v = RawVertex::new(p, normal);

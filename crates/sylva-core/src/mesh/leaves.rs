@@ -2,8 +2,7 @@
 //! §2.4). See [`crate::mesh`] for the construction.
 
 use crate::mesh::{RawMeshInfo, RawVertex};
-use crate::model::leaf_shape::leaf_rim;
-use crate::model::{LeafShape, RawLeaf, RawSegment};
+use crate::model::{RawLeaf, RawSegment};
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
@@ -23,11 +22,7 @@ pub fn mesh_leaves(
     vertex: &mut [RawVertex],
 ) {
     let stride = info.leaf_sides as usize + 1;
-    // Each shape's rim once (the disc's two half-circles, or a polygon holding the outline).
-    // One past the last shape: what an unknown index gets on both sides (the default radius).
-    let rims: Vec<Vec<(f32, f32)>> = (0..=LeafShape::ALL.len() as u32)
-        .map(|shape| (0..info.leaf_sides).map(|k| leaf_rim(shape, k, info.leaf_sides)).collect())
-        .collect();
+    let rims = super::uv::leaf_rims(info.leaf_sides);
     vertex.par_chunks_mut(stride).zip(leaf.par_iter()).for_each(|(out, lf)| {
         let s = lf.segment as usize;
         let d = Quat::from_array(acc[s]);
@@ -42,8 +37,8 @@ pub fn mesh_leaves(
         for (k, v) in out.iter_mut().enumerate() {
             // (u, v) on the blade: the centre, then the rim from the base through +u to the
             // tip and back, scaled to width and length.
-            let uv = if k > 0 { rim[k - 1] } else { (0.5, 0.5) };
-            let p = base + qx * ((uv.0 - 0.5) * lf.width) + qy * (uv.1 * lf.length);
+            let uv = if k > 0 { rim[k - 1] } else { [0.5, 0.5] };
+            let p = base + qx * ((uv[0] - 0.5) * lf.width) + qy * (uv[1] * lf.length);
             *v = RawVertex::new(p, normal);
         }
     });

@@ -76,29 +76,29 @@ pub(crate) fn vertex_buffer(ctx: &GpuContext, label: &'static str, len: usize) -
     }))
 }
 
-/// A static vertex buffer of texture coordinates (the second stream beside the vertices).
-pub(crate) fn uv_buffer(ctx: &GpuContext, label: &'static str, uv: &[Uv]) -> wgpu::Buffer {
-    let mut data = uv.to_vec();
-    if data.is_empty() {
-        data.push([0.0; 2]);
-    }
+/// A buffer made once from `data` (one zero element when empty: a binding can't be).
+fn static_buffer<T: bytemuck::Pod>(
+    ctx: &GpuContext,
+    label: &'static str,
+    data: &[T],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let zero = [T::zeroed()];
+    let contents = if data.is_empty() { &zero[..] } else { data };
     ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some(label),
-        contents: bytemuck::cast_slice(&data),
-        usage: wgpu::BufferUsages::VERTEX,
+        contents: bytemuck::cast_slice(contents),
+        usage,
     })
 }
 
+/// A static vertex buffer of texture coordinates (the second stream beside the vertices).
+pub(crate) fn uv_buffer(ctx: &GpuContext, label: &'static str, uv: &[Uv]) -> wgpu::Buffer {
+    static_buffer(ctx, label, uv, wgpu::BufferUsages::VERTEX)
+}
+
 pub(crate) fn index_buffer(ctx: &GpuContext, label: &'static str, indices: &[u32]) -> wgpu::Buffer {
-    let mut data = indices.to_vec();
-    if data.is_empty() {
-        data.push(0);
-    }
-    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(label),
-        contents: bytemuck::cast_slice(&data),
-        usage: wgpu::BufferUsages::INDEX,
-    })
+    static_buffer(ctx, label, indices, wgpu::BufferUsages::INDEX)
 }
 
 /// The bark or leaf kernel, its runs of vertices staged in workgroup memory or written
