@@ -113,10 +113,13 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     for &(instances, paper_branches, paper_dx9_ms, paper_dx10_ms, paper_dx10_slod2_ms, paper_skin_ms) in rows {
         let placed = ZiomaInstance::grid(instances, 8.0, 1);
-        // Pose: segments and stems read, rotations written then read, joints and
-        // accumulated rotations written. Skinning: rest vertex and weights read, vertex written.
+        // Pose: each instance's record read and its frame written then read; segments and
+        // stems read, rotations written then read, joints and accumulated rotations written.
+        // Skinning: rest vertex and weights read, vertex written.
         let pose_bytes = instances
-            * (n_seg * (std::mem::size_of::<sylva_core::model::RawSegment>() + 16 + 16 + 16 + 16)
+            * (std::mem::size_of::<sylva_core::methods::zioma::RawZiomaInstance>()
+                + 2 * std::mem::size_of::<sylva_core::methods::zioma::RawZiomaFrame>()
+                + n_seg * (std::mem::size_of::<sylva_core::model::RawSegment>() + 16 + 16 + 16 + 16)
                 + tree.stems.len() * std::mem::size_of::<sylva_core::methods::zioma::RawZiomaStem>());
         let skin_bytes = instances * verts * (2 * std::mem::size_of::<RawVertex>() + 16);
         let bytes = pose_bytes + skin_bytes;

@@ -37,6 +37,10 @@ pub const POSE_JUMP_TERMS: &str = include_str!("pose/pose_jump_terms.wgsl");
 pub const POSE_JUMP_SUMS: &str = include_str!("pose/pose_jump_sums.wgsl");
 /// Kernel: joints from rest joints and summed displacements.
 pub const POSE_JUMP_JOINTS: &str = include_str!("pose/pose_jump_joints.wgsl");
+/// Zioma's per-frame records (`ZiomaFrame`, `ZiomaTrunk`, `ZiomaInstance`).
+pub const ZIOMA: &str = include_str!("methods/zioma/zioma.wgsl");
+/// Kernel: every Zioma instance's per-frame values (the trunk's lean, bands and rate).
+pub const ZIOMA_FRAMES: &str = include_str!("methods/zioma/zioma_frames.wgsl");
 /// Kernel: Zioma's per-segment rotations.
 pub const ZIOMA_ROTATIONS: &str = include_str!("methods/zioma/zioma_rotations.wgsl");
 /// Kernel: trunk noise bands at many (t, tree) samples.
@@ -96,9 +100,9 @@ pub const MESH: &str = include_str!("mesh/mesh.wgsl");
 pub const MESH_TUBES: &str = include_str!("mesh/mesh_tubes.wgsl");
 /// Kernel: midpoint vertices of subdivided bark bands (§2.3).
 pub const MESH_DETAIL: &str = include_str!("mesh/mesh_detail.wgsl");
-/// Kernel: leaf-polygon vertices.
 /// Leaf outlines: `leaf_radius`, `leaf_rim`, `inside_leaf_shape` (twin of `sylva_core::model::leaf_shape`).
 pub const LEAF_SHAPE: &str = include_str!("wgsl/leaf_shape.wgsl");
+/// Kernel: leaf-polygon vertices.
 pub const MESH_LEAVES: &str = include_str!("mesh/mesh_leaves.wgsl");
 /// Kernel: two-bone skinning of a rest mesh, instance-major.
 pub const SKIN_VERTICES: &str = include_str!("mesh/skin_vertices.wgsl");
@@ -138,7 +142,8 @@ kernels! {
     pose_jump_sums: [TREE, POSE_JUMP_SUMS] => sylva_core::pose::fk::pose_jump_sums;
     pose_jump_joints: [POSE_JUMP_JOINTS] => sylva_core::pose::fk::pose_jump_joints;
     trunk_noise: [NOISE, TRUNK_NOISE] => sylva_core::methods::zioma::trunk::trunk_noise;
-    zioma_rotations: [QUAT, TREE, NOISE, WIND, ZIOMA_ROTATIONS] => sylva_core::methods::zioma::rotations::zioma_rotations;
+    zioma_frames: [NOISE, WIND, ZIOMA, ZIOMA_FRAMES] => sylva_core::methods::zioma::frames::zioma_frames;
+    zioma_rotations: [QUAT, TREE, NOISE, WIND, ZIOMA, ZIOMA_ROTATIONS] => sylva_core::methods::zioma::rotations::zioma_rotations;
     akagi_forces: [QUAT, TREE, NOISE, WIND, AKAGI, AKAGI_FORCES] => sylva_core::methods::akagi::kernels::akagi_forces;
     akagi_subtree: [AKAGI_SUBTREE] => sylva_core::methods::akagi::kernels::akagi_subtree;
     akagi_integrate: [QUAT, TREE, OSCILLATOR, AKAGI, AKAGI_INTEGRATE] => sylva_core::methods::akagi::kernels::akagi_integrate;

@@ -296,3 +296,103 @@ fn zioma_instances_match_and_sway_independently() {
         assert!(distinct >= instances.len() - 2, "instances sway alike: {distinct} differ");
     }
 }
+
+/// The frame kernel (`zioma_frames.wgsl`) against its CPU twin, on every wind preset, three
+/// trees, random instances (±300 m, any yaw), random rings and random times up to 600 s.
+/// Tolerances: the lean direction within 2e-4 rad, the trunk angles within 1e-5 rad and
+/// their rate within 1e-3 rad/s, each plus how far the CPU's own value moves when the time
+/// moves by two f32 ulps (as [`time_rounding_allowance`]: a GPU that fuses `ω t + φ` rounds
+/// the wind's phases differently); the heading within 1e-6, the rest of the record bit for
+/// bit. Lavapipe, 2026-12-03: 4.4e-5 rad, 1.9e-7 rad and 1.2e-5 rad/s at worst.
+#[test]
+fn zioma_frames_match_their_cpu_twin() {
+    use sylva_core::methods::zioma::frames::zioma_frames;
+    use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaInstance, Ring};
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(31);
+    let mut worst = [0.0f32; 3];
+    for (name, _, _) in sylva_core::wind::PRESETS {
+        let wind = WindScene::resolve(name).unwrap();
+        let packed = wind.packed();
+        let gpu_wind = GpuWind::from_scene(ctx, &wind).unwrap();
+        for species in ["quaking_aspen", "stochastic_bush", "palm"] {
+            let t = SpeciesSource::resolve(species).unwrap().generate(rng.random(), &Default::default(), None).unwrap();
+            let z = Zioma::new(&t, ZiomaParams { seed: rng.random(), ..Default::default() });
+            let instances: Vec<RawZiomaInstance> = (0..97)
+                .map(|_| RawZiomaInstance {
+                    position: [rng.random_range(-300.0..300.0), 0.0, rng.random_range(-300.0..300.0)],
+                    yaw: rng.random_range(0.0..std::f32::consts::TAU),
+                    phase: rng.random(),
+                    seed: rng.random(),
+                    _pad: [0; 2],
+                })
+                .collect();
+            for round in 0..3 {
+                let time = rng.random_range(0.0..600.0);
+                let ring = if round == 0 {
+                    Ring::default()
+                } else {
+                    let v = |rng: &mut rand::rngs::StdRng, s: f32| {
+                        Vec3::new(rng.random_range(-s..s), 0.0, rng.random_range(-s..s))
+                    };
+                    Ring {
+                        bend: v(&mut rng, 0.1),
+                        rate: v(&mut rng, 0.5),
+                        since: time - rng.random_range(0.0..10.0),
+                        zeta: rng.random_range(0.02..0.3),
+                    }
+                };
+                let cpu_at = |time: f32| {
+                    let mut out = vec![<RawZiomaFrame as bytemuck::Zeroable>::zeroed(); instances.len()];
+                    zioma_frames(&packed.fields, &packed.waves, &[z.raw_trunk(time, &ring)], &instances, &mut out);
+                    out
+                };
+                let cpu = cpu_at(time);
+                let dt = 2.0 * time * 2f32.powi(-23);
+                let (early, late) = (cpu_at(time - dt), cpu_at(time + dt));
+                let gpu = sylva_gpu::methods::zioma::frames::zioma_frames(
+                    ctx,
+                    &gpu_wind,
+                    &z.raw_trunk(time, &ring),
+                    &instances,
+                )
+                .unwrap();
+                for (k, (a, b)) in cpu.iter().zip(&gpu).enumerate() {
+                    let what = format!("{name}, {species}, instance {k}, t = {time} s, ring {ring:?}");
+                    let spread =
+                        |f: &dyn Fn(&RawZiomaFrame) -> f32| (f(a) - f(&early[k])).abs().max((f(a) - f(&late[k])).abs());
+                    let dir = |f: &RawZiomaFrame| Vec3::from_array(f.wind_dir);
+                    // The chord between unit vectors: acos near 1 cannot resolve 1e-4 rad in f32.
+                    let turn = (dir(a) - dir(b)).length();
+                    let allowed = (dir(a) - dir(&early[k])).length().max((dir(a) - dir(&late[k])).length());
+                    assert!(turn.is_finite() && turn <= 2e-4 + allowed, "{what}: lean {turn} rad apart");
+                    worst[0] = worst[0].max(turn);
+                    for axis in 0..3 {
+                        let d = (a.trunk[axis] - b.trunk[axis]).abs();
+                        let bound = 1e-5 + spread(&|f| f.trunk[axis]);
+                        assert!(d <= bound, "{what}: trunk angle {axis}: {} vs {}", a.trunk[axis], b.trunk[axis]);
+                        worst[1] = worst[1].max(d);
+                    }
+                    let d = (a.trunk_rate - b.trunk_rate).abs();
+                    assert!(d <= 1e-3 + spread(&|f| f.trunk_rate), "{what}: rate {} vs {}", a.trunk_rate, b.trunk_rate);
+                    worst[2] = worst[2].max(d);
+                    let rest =
+                        |f: &RawZiomaFrame| (f.time, f.lod, f.amplitude, f.max_bend, f.inertia, f.origin, f.phase);
+                    assert_eq!(rest(a), rest(b), "{what}");
+                    for h in 0..2 {
+                        assert!(
+                            (a.heading[h] - b.heading[h]).abs() <= 1e-6,
+                            "{what}: heading {:?} vs {:?}",
+                            a.heading,
+                            b.heading
+                        );
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "zioma frames: worst lean {:.1e} rad, trunk angle {:.1e} rad, rate {:.1e} rad/s",
+        worst[0], worst[1], worst[2]
+    );
+}

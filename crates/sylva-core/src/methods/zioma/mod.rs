@@ -27,6 +27,7 @@
 //! * **Hierarchy** (§6.4): per-branch angles become quaternions, concatenated from the root
 //!   down by the pose seam ([`crate::pose`]); **LOD**: trunk only, or trunk and branches.
 
+pub mod frames;
 pub mod raw;
 pub mod rotations;
 pub mod trunk;
@@ -42,12 +43,12 @@ use crate::rng::{child_key, mix64};
 use crate::wind::PackedWind;
 use crate::wind::WindScene;
 use crate::wind::raw::{RawField, RawWave};
+use bytemuck::Zeroable;
 use glam::Vec3;
-use rayon::prelude::*;
 use rotations::zioma_rotations;
 use std::sync::Arc;
 pub use trunk::Ring;
-use trunk::{TrunkModel, TrunkNoise};
+use trunk::TrunkModel;
 
 /// Simulation level of detail (§6.5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
@@ -198,6 +199,32 @@ impl Zioma {
         self.frame_for(fields, waves, t, None, ring)
     }
 
+    /// The tree's values for a frame at time `t`, ringing by `ring` (what the frame kernel
+    /// reads beside each instance).
+    pub fn raw_trunk(&self, t: f32, ring: &Ring) -> RawZiomaTrunk {
+        let m = &self.trunk;
+        RawZiomaTrunk {
+            crown_centre: self.crown_centre.to_array(),
+            natural_frequency: m.natural_frequency,
+            ring_bend: ring.bend.to_array(),
+            tip_per_pascal: m.tip_per_pascal,
+            ring_rate: ring.rate.to_array(),
+            pressure_centre: m.pressure_centre,
+            lever: m.lever,
+            damping_ratio: m.damping_ratio,
+            reconfiguration_speed: m.drag.reconfiguration_speed,
+            vogel_exponent: m.drag.vogel_exponent,
+            ring_since: ring.since,
+            ring_zeta: ring.zeta,
+            time: t,
+            tree_seed: self.tree_seed,
+            lod: (self.params.lod == Lod::Full) as u32,
+            amplitude: self.params.amplitude,
+            max_bend: self.params.max_bend,
+            inertia: self.params.inertia,
+        }
+    }
+
     /// The per-frame values of one instance (`None`: the tree at the origin, unturned).
     pub fn frame_for(
         &self,
@@ -207,40 +234,12 @@ impl Zioma {
         instance: Option<&ZiomaInstance>,
         ring: &Ring,
     ) -> RawZiomaFrame {
-        let (centre, seed) = match instance {
-            Some(i) => (i.to_world(self.crown_centre), self.tree_seed ^ i.seed),
-            None => (self.crown_centre, self.tree_seed),
-        };
-        // The trunk's lean (its oscillator's answer to the wind, horizontal, in the tree's
-        // frame), with chaos bands on top.
-        let lean = |t: f32| {
-            let b = self.trunk.bend(fields, waves, centre, t) + self.trunk.ring_at(ring, t).0;
-            let b = instance.map_or(b, |i| i.to_local(b));
-            let theta = b.length().min(trunk::MAX_TRUNK_BEND);
-            (b.try_normalize().unwrap_or(Vec3::ZERO), TrunkNoise::new(self.trunk.natural_frequency, theta))
-        };
-        let (dir, noise) = lean(t);
-        let a = noise.angles(t, seed);
-        let dt = 0.01;
-        let rate = (lean(t + dt).1.angles(t + dt, seed)[0] - lean(t - dt).1.angles(t - dt, seed)[0]) / (2.0 * dt);
-        let (sin, cos) = instance.map_or((0.0, 1.0), |i| i.yaw.sin_cos());
-        RawZiomaFrame {
-            wind_dir: dir.to_array(),
-            time: t,
-            trunk: a,
-            trunk_rate: rate,
-            lod: (self.params.lod == Lod::Full) as u32,
-            amplitude: self.params.amplitude,
-            max_bend: self.params.max_bend,
-            inertia: self.params.inertia,
-            origin: instance.map_or([0.0; 3], |i| i.position.to_array()),
-            phase: instance.map_or(0.0, |i| i.phase),
-            heading: [cos, sin],
-            _pad: [0.0; 2],
-        }
+        let instance = instance.map_or(RawZiomaInstance::zeroed(), RawZiomaInstance::from);
+        frames::zioma_frame(fields, waves, &self.raw_trunk(t, ring), &instance)
     }
 
-    /// The per-frame values of every instance (in parallel; each on its own).
+    /// The per-frame values of every instance (in parallel; each on its own), by the frame
+    /// kernel's CPU twin ([`frames::zioma_frames`]).
     pub fn frames_for(
         &self,
         fields: &[RawField],
@@ -249,7 +248,10 @@ impl Zioma {
         instances: &[ZiomaInstance],
         ring: &Ring,
     ) -> Vec<RawZiomaFrame> {
-        instances.par_iter().map(|i| self.frame_for(fields, waves, t, Some(i), ring)).collect()
+        let raw: Vec<RawZiomaInstance> = instances.iter().map(RawZiomaInstance::from).collect();
+        let mut out = vec![RawZiomaFrame::zeroed(); raw.len()];
+        frames::zioma_frames(fields, waves, &[self.raw_trunk(t, ring)], &raw, &mut out);
+        out
     }
 
     /// Per-segment rotations δ of every instance at time `t`, instance by instance

@@ -60,3 +60,71 @@ pub struct RawZiomaFrame {
     /// Padding.
     pub _pad: [f32; 2],
 }
+
+/// One tree's values for a frame, 96 bytes: its trunk ([`super::trunk::TrunkModel`]), the
+/// ring it is ringing by ([`super::Ring`]), the time and the method's parameters. WGSL:
+/// `ZiomaTrunk` in `zioma.wgsl`; the frame kernel ([`super::frames`]) reads it once for every
+/// instance.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawZiomaTrunk {
+    /// Where the trunk's wind is sampled (the crown's centre, tree frame), m.
+    pub crown_centre: [f32; 3],
+    /// First-mode frequency f₀, Hz.
+    pub natural_frequency: f32,
+    /// The ring's bend at its change, rad (scene frame).
+    pub ring_bend: [f32; 3],
+    /// Trunk-top deflection per pascal on the crown, m/Pa.
+    pub tip_per_pascal: f32,
+    /// The ring's rate of bend at its change, rad/s.
+    pub ring_rate: [f32; 3],
+    /// Centre of pressure, share of the tip's motion.
+    pub pressure_centre: f32,
+    /// Trunk-top motion per radian of arc, m.
+    pub lever: f32,
+    /// Structural damping ratio.
+    pub damping_ratio: f32,
+    /// Reconfiguration speed U_r, m/s.
+    pub reconfiguration_speed: f32,
+    /// Vogel exponent B.
+    pub vogel_exponent: f32,
+    /// Time of the ring's change, s.
+    pub ring_since: f32,
+    /// The ring's damping ratio.
+    pub ring_zeta: f32,
+    /// Time of the frame, s.
+    pub time: f32,
+    /// Seed of the tree's trunk noise (an instance's seed is XORed in).
+    pub tree_seed: u32,
+    /// 0 = trunk only, 1 = full.
+    pub lod: u32,
+    /// Branch amplitude scale.
+    pub amplitude: f32,
+    /// Largest static bend, rad.
+    pub max_bend: f32,
+    /// Inertia gain.
+    pub inertia: f32,
+}
+
+/// A placed instance ([`crate::pose::Placement`]) as the frame kernel reads it, 32 bytes.
+/// WGSL: `ZiomaInstance` in `zioma.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawZiomaInstance {
+    /// Position of the tree's origin in the world, m.
+    pub position: [f32; 3],
+    /// Rotation about +Y, rad.
+    pub yaw: f32,
+    /// Phase offset of every branch, cycles.
+    pub phase: f32,
+    /// Seed of the trunk's noise for this instance.
+    pub seed: u32,
+    /// Padding.
+    pub _pad: [u32; 2],
+}
+
+impl From<&crate::pose::Placement> for RawZiomaInstance {
+    fn from(p: &crate::pose::Placement) -> Self {
+        Self { position: p.position.to_array(), yaw: p.yaw, phase: p.phase, seed: p.seed, _pad: [0; 2] }
+    }
+}

@@ -233,6 +233,12 @@ impl TrunkModel {
     }
 }
 
+/// The trunk's noise bands: axis (0 parallel, 1 perpendicular, 2 twist), noise stream,
+/// frequency (× f₀), amplitude and bias (× θ). `zioma_frames.wgsl` writes the same table
+/// out (`trunk_noise_angles`); the parity test holds them together.
+pub const TRUNK_BANDS: [(u32, u32, f32, f32, f32); 4] =
+    [(0, 0x13, 2.3, 0.12, 1.0), (0, 0x14, 5.1, 0.05, 0.0), (1, 0x22, 3.1, 0.06, 0.0), (2, 0x31, 1.3, 0.08, 0.0)];
+
 /// The noise bands of one tree in one wind.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrunkNoise {
@@ -257,12 +263,7 @@ impl TrunkNoise {
             bias: bias * theta,
             _pad: [0; 3],
         };
-        let bands = vec![
-            band(0, 0x13, 2.3, 0.12, 1.0),
-            band(0, 0x14, 5.1, 0.05, 0.0),
-            band(1, 0x22, 3.1, 0.06, 0.0),
-            band(2, 0x31, 1.3, 0.08, 0.0),
-        ];
+        let bands = TRUNK_BANDS.iter().map(|&(axis, seed, fr, amp, bias)| band(axis, seed, fr, amp, bias)).collect();
         Self { natural_frequency: f0, static_bend: theta, bands }
     }
 

@@ -1,6 +1,9 @@
-//! Zioma's method on the GPU: rotations from `zioma_rotations.wgsl`, the pose from
-//! [`GpuPose`], every instance in one submission per frame (§6.5 instancing).
+//! Zioma's method on the GPU: every instance's frame values from `zioma_frames.wgsl`, the
+//! rotations from `zioma_rotations.wgsl`, the pose from [`GpuPose`], every instance in one
+//! submission per frame (§6.5 instancing). The CPU writes 96 bytes a frame (the tree's
+//! [`RawZiomaTrunk`]: the time and the ring), whatever the number of instances.
 
+pub mod frames;
 pub mod trunk_noise;
 
 use super::{BuildError, GpuAnimator};
@@ -12,7 +15,7 @@ use crate::{GpuContext, GpuError};
 use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::methods::MethodOptions;
-use sylva_core::methods::zioma::{RawZiomaFrame, Ring, Zioma, ZiomaParams};
+use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaInstance, RawZiomaTrunk, Ring, Zioma, ZiomaParams};
 use sylva_core::pose::{Placement, Pose};
 
 /// Zioma's method on the GPU for one tree and its placed instances.
@@ -20,15 +23,20 @@ use sylva_core::pose::{Placement, Pose};
 pub struct GpuZioma {
     tree: Arc<Tree>,
     method: Zioma,
+    frames_kernel: Arc<Kernel>,
     kernel: Arc<Kernel>,
     pose: GpuPose,
     wind: GpuWind,
     segments: wgpu::Buffer,
     stems: wgpu::Buffer,
+    /// The tree's values for the frame ([`RawZiomaTrunk`]), written each frame.
+    trunk: wgpu::Buffer,
+    /// The instances ([`RawZiomaInstance`]; one unturned at the origin for a single tree).
+    placements: wgpu::Buffer,
+    /// One [`RawZiomaFrame`] per instance, written by the frame kernel.
     frame: wgpu::Buffer,
-    instances: Vec<Placement>,
     leaves: GpuLeafFlutter,
-    /// The rotation kernel, bound on first use after the wind is set.
+    /// The frame and rotation kernels, bound on first use after the wind is set.
     rotations: Option<Plan>,
     /// The trunk's ring-down since the wind last changed (as the CPU's state).
     ring: Ring,
@@ -43,8 +51,8 @@ impl GpuZioma {
     }
 
     /// Many placed instances of the tree (§6.5 instancing): one dispatch for every
-    /// (instance, segment) and one forward-kinematics pass over them all per frame. An empty
-    /// list is the single tree at the origin.
+    /// instance's frame values, one for every (instance, segment) and one forward-kinematics
+    /// pass over them all per frame. An empty list is the single tree at the origin.
     pub fn with_instances(
         ctx: &GpuContext,
         tree: Arc<Tree>,
@@ -54,16 +62,23 @@ impl GpuZioma {
     ) -> Result<Self, GpuError> {
         let count = instances.len().max(1);
         let zeroed: RawZiomaFrame = bytemuck::Zeroable::zeroed();
+        let mut placements: Vec<RawZiomaInstance> = instances.iter().map(RawZiomaInstance::from).collect();
+        if placements.is_empty() {
+            placements.push(bytemuck::Zeroable::zeroed());
+        }
         let ring = method.start_ring(&wind.packed.fields, &wind.packed.waves);
+        let trunk: RawZiomaTrunk = method.raw_trunk(0.0, &ring);
         Ok(Self {
             ring,
+            frames_kernel: Kernel::get(ctx, "zioma_frames"),
             kernel: Kernel::get(ctx, "zioma_rotations"),
             pose: GpuPose::with_instances(ctx, &tree, count)?,
             wind: wind.clone(),
             segments: upload(ctx, "segments", &tree.raw_segments())?,
             stems: upload(ctx, "zioma stems", &method.stems)?,
+            trunk: upload(ctx, "zioma trunk", &[trunk])?,
+            placements: upload(ctx, "zioma instances", &placements)?,
             frame: upload(ctx, "zioma frames", &vec![zeroed; count])?,
-            instances: instances.to_vec(),
             leaves: GpuLeafFlutter::new(ctx, &method.leaves)?,
             rotations: None,
             tree,
@@ -77,9 +92,7 @@ impl GpuZioma {
         &self.method
     }
 
-    /// Records and submits every instance's pose at time `t` without reading it back (the
-    /// per-instance frame values are computed on the CPU: the trunk's filtered wind and its
-    /// bands each).
+    /// Records and submits every instance's pose at time `t` without reading it back.
     pub fn submit(&mut self, ctx: &GpuContext, t: f32) {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         self.record(ctx, &mut encoder, t);
@@ -87,18 +100,16 @@ impl GpuZioma {
     }
 
     /// Records every instance's pose at time `t` into `encoder`, for work that reads it in
-    /// the same submission (skinning, meshing); the frame values are written to the queue now,
-    /// so record one pose per submission.
+    /// the same submission (skinning, meshing); the tree's values for the frame are written to
+    /// the queue now, so record one pose per submission.
     pub fn record(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, t: f32) {
         self.time = t;
-        let (m, w) = (&self.method, &*self.wind.packed);
-        let frames: Vec<RawZiomaFrame> = if self.instances.is_empty() {
-            vec![m.frame(&w.fields, &w.waves, t, &self.ring)]
-        } else {
-            m.frames_for(&w.fields, &w.waves, t, &self.instances, &self.ring)
-        };
-        ctx.queue.write_buffer(&self.frame, 0, bytemuck::cast_slice(&frames));
+        let trunk = self.method.raw_trunk(t, &self.ring);
+        ctx.queue.write_buffer(&self.trunk, 0, bytemuck::bytes_of(&trunk));
         let plan = self.rotations.get_or_insert_with(|| {
+            let mut plan = Plan::default();
+            let buffers = [&self.wind.fields, &self.wind.waves, &self.trunk, &self.placements, &self.frame];
+            plan.push(ctx, &self.frames_kernel, &buffers, self.pose.instance_count() as u32);
             let buffers = [
                 &self.wind.fields,
                 &self.wind.waves,
@@ -107,7 +118,6 @@ impl GpuZioma {
                 &self.frame,
                 self.pose.delta_buffer(),
             ];
-            let mut plan = Plan::default();
             plan.push(ctx, &self.kernel, &buffers, (self.pose.segment_count() * self.pose.instance_count()) as u32);
             plan
         });
@@ -122,8 +132,7 @@ impl GpuZioma {
         self.pose.read_all(ctx)
     }
 
-    /// The pose at time `t`: the per-tree frame values are computed on the CPU (one wind
-    /// sample and the trunk bands), everything per segment on the GPU.
+    /// The pose at time `t`.
     pub fn pose(&mut self, ctx: &GpuContext, t: f32) -> Result<Pose, GpuError> {
         self.submit(ctx, t);
         self.pose.read(ctx)

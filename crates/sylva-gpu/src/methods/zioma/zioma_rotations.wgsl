@@ -1,4 +1,4 @@
-// zioma_rotations: Zioma's per-segment rotations. CPU twin:
+// zioma_rotations: Zioma's per-segment rotations (`ZiomaFrame` from zioma.wgsl). CPU twin:
 // sylva_core::methods::zioma::rotations (bindings 0 fields, 1 waves — from wind.wgsl —
 // 2 segments, 3 stems, 4 frames (one per instance), 5 delta, instance-major).
 
@@ -13,21 +13,6 @@ struct ZiomaStem {
     seed: u32,
     length: f32,
     _pad: u32,
-}
-
-struct ZiomaFrame {
-    wind_dir: vec3<f32>,
-    time: f32,
-    trunk: vec3<f32>,
-    trunk_rate: f32,
-    lod: u32,
-    amplitude: f32,
-    max_bend: f32,
-    inertia: f32,
-    origin: vec3<f32>,
-    phase: f32,
-    heading: vec2<f32>,
-    _pad: vec2<f32>,
 }
 
 @group(0) @binding(2) var<storage, read> segments: array<Segment>;

@@ -1,0 +1,27 @@
+//! GPU twin of [`sylva_core::methods::zioma::frames::zioma_frames`]: every instance's frame
+//! values in one dispatch. [`super::GpuZioma`] records the kernel in its plan; this runs it
+//! once and reads the result back (tests, tools).
+
+use crate::kernel::{Kernel, output, read_back, upload};
+use crate::wind::GpuWind;
+use crate::{GpuContext, GpuError};
+use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaInstance, RawZiomaTrunk};
+
+/// The frame values of every instance in `instances` for the tree's values `trunk`, in the
+/// wind `wind`.
+pub fn zioma_frames(
+    ctx: &GpuContext,
+    wind: &GpuWind,
+    trunk: &RawZiomaTrunk,
+    instances: &[RawZiomaInstance],
+) -> Result<Vec<RawZiomaFrame>, GpuError> {
+    if instances.is_empty() {
+        return Ok(Vec::new());
+    }
+    let kernel = Kernel::get(ctx, "zioma_frames");
+    let k = upload(ctx, "zioma trunk", std::slice::from_ref(trunk))?;
+    let i = upload(ctx, "zioma instances", instances)?;
+    let out = output::<RawZiomaFrame>(ctx, "zioma frames", instances.len())?;
+    kernel.run(ctx, &[&wind.fields, &wind.waves, &k, &i, &out], instances.len() as u32);
+    read_back(ctx, &out, instances.len())
+}
