@@ -235,3 +235,53 @@ fn trunk_only_lod_moves_branches_rigidly() {
     let pose = z.pose_at(&t, &wind.packed(), 4.0);
     assert!(displacement(&t, &pose).max[0] > 0.0);
 }
+
+/// Zioma's instances once shared the tree's ring, taken at its own crown: when the wind
+/// changed, every copy where the wind differs (a forest's) jumped by the difference between
+/// its wind's answer and the crown's. Each registered instance keeps its own ring, taken at
+/// its own crown, so its trunk's lean and bands are continuous across a change (here the
+/// gusty wind stopping at 3 s, then a steady 8 m/s wind starting a second later while the
+/// trunks still ring), within 1e-5 rad; with the tree's ring they jump by more than 1e-3 rad
+/// somewhere in the grid, so the check can fail.
+#[test]
+fn zioma_instances_jumped_when_the_wind_changed() {
+    use sylva_core::methods::Method;
+    use sylva_core::methods::zioma::{RawZiomaFrame, ZiomaInstance};
+    use sylva_core::wind::PackedWind;
+    let t = tree("quaking_aspen");
+    let z = Zioma::new(&t, ZiomaParams::default());
+    let gusty = WindScene::resolve("gusty").unwrap().packed();
+    let winds = [PackedWind::calm(), constant(8.0, [0.3, 0.0, 1.0]).packed()];
+    let instances = ZiomaInstance::grid(16, 40.0, 3);
+    let mut s = z.rest_state(&t);
+    z.set_instances(&t, &mut s, &instances);
+    for _ in 0..180 {
+        z.step(&t, &gusty, &mut s, 1.0 / 60.0);
+    }
+    let lean = |f: &RawZiomaFrame| Vec3::from_array(f.wind_dir) * f.trunk[0];
+    let mut old_wind = gusty;
+    for new_wind in winds {
+        let (change, before) = (s.time, s.rings.clone());
+        assert_eq!(before.len(), instances.len());
+        z.step(&t, &new_wind, &mut s, 1.0 / 60.0);
+        let old = z.frames_for(&old_wind.fields, &old_wind.waves, change, &instances, &before);
+        let new = z.frames_for(&new_wind.fields, &new_wind.waves, change, &instances, &s.rings);
+        let shared = vec![s.ring; instances.len()];
+        let shared = z.frames_for(&new_wind.fields, &new_wind.waves, change, &instances, &shared);
+        let (mut worst, mut worst_shared) = (0.0f32, 0.0f32);
+        for k in 0..instances.len() {
+            let jump = (lean(&old[k]) - lean(&new[k])).length();
+            let bands = (0..3).map(|a| (old[k].trunk[a] - new[k].trunk[a]).abs()).fold(0.0, f32::max);
+            assert!(jump <= 1e-5 && bands <= 1e-5, "{change} s, instance {k}: the trunk jumps {jump} rad ({bands})");
+            assert!(lean(&old[k]).length() > 1e-3, "{change} s, instance {k} does not lean");
+            worst = worst.max(jump);
+            worst_shared = worst_shared.max((lean(&old[k]) - lean(&shared[k])).length());
+        }
+        println!("change at {change} s: worst jump {worst:.1e} rad; with the tree's ring {worst_shared:.1e} rad");
+        assert!(worst_shared > 1e-3, "the tree's ring would do as well ({worst_shared} rad): the check cannot fail");
+        for _ in 0..59 {
+            z.step(&t, &new_wind, &mut s, 1.0 / 60.0);
+        }
+        old_wind = new_wind;
+    }
+}

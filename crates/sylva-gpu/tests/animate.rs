@@ -218,22 +218,23 @@ fn zioma_matches_on_every_preset_at_random_times() {
     }
 }
 
-/// When the wind stops, the GPU's trunk rings down as the CPU's state does (`set_wind` starts
-/// the same ring): a second into the calm the poses agree within 1e-4 × height, and the tree
-/// is still moving.
-#[test]
-fn zioma_rings_down_on_the_gpu_as_on_the_cpu_when_the_wind_stops() {
+/// Zioma on the bush with `instances` (none: the single tree), on the CPU (instances
+/// registered) and the GPU, through 5 s of the gusty wind and then a second of calm.
+fn gusty_then_calm(
+    ctx: &sylva_gpu::GpuContext,
+    instances: &[sylva_core::pose::Placement],
+) -> (Tree, Zioma, sylva_core::methods::zioma::ZiomaState, GpuZioma) {
     use sylva_core::methods::Method;
     use sylva_core::wind::PackedWind;
     use sylva_gpu::methods::GpuAnimator;
-    let Some(ctx) = common::gpu() else { return };
     let wind = WindScene::resolve("gusty").unwrap();
     let (fw, calm) = (wind.packed(), PackedWind::calm());
     let t = SpeciesSource::resolve("stochastic_bush").unwrap().generate(4, &Default::default(), None).unwrap();
     let z = Zioma::new(&t, ZiomaParams::default());
-    let mut gpu =
-        GpuZioma::new(ctx, Arc::new(t.clone()), z.clone(), &GpuWind::from_scene(ctx, &wind).unwrap()).unwrap();
+    let gpu_wind = GpuWind::from_scene(ctx, &wind).unwrap();
+    let mut gpu = GpuZioma::with_instances(ctx, Arc::new(t.clone()), z.clone(), &gpu_wind, instances).unwrap();
     let mut s = z.rest_state(&t);
+    z.set_instances(&t, &mut s, instances);
     for _ in 0..300 {
         z.step(&t, &fw, &mut s, 1.0 / 60.0);
     }
@@ -243,11 +244,43 @@ fn zioma_rings_down_on_the_gpu_as_on_the_cpu_when_the_wind_stops() {
         z.step(&t, &calm, &mut s, 1.0 / 60.0);
     }
     gpu.advance(ctx, 1.0 / 60.0, 60);
-    let cpu = z.pose(&t, &calm, &s);
-    let time = gpu.time;
-    assert_eq!(time, s.time);
-    compare(&t, &cpu, &gpu.pose(ctx, time).unwrap(), "a second into the calm");
+    assert_eq!(gpu.time, s.time);
+    (t, z, s, gpu)
+}
+
+/// When the wind stops, the GPU's trunk rings down as the CPU's state does (`set_wind` starts
+/// the same ring): a second into the calm the poses agree within 1e-4 × height, and the tree
+/// is still moving.
+#[test]
+fn zioma_rings_down_on_the_gpu_as_on_the_cpu_when_the_wind_stops() {
+    use sylva_core::methods::Method;
+    let Some(ctx) = common::gpu() else { return };
+    let (t, z, s, mut gpu) = gusty_then_calm(ctx, &[]);
+    let cpu = z.pose(&t, &sylva_core::wind::PackedWind::calm(), &s);
+    compare(&t, &cpu, &gpu.pose(ctx, s.time).unwrap(), "a second into the calm");
     assert_ne!(cpu, Pose::rest(&t), "the trunk does not ring");
+}
+
+/// A forest's copies each ring down by their own ring on the GPU as on the CPU (the
+/// instances registered with `set_instances`): a second after the gusty wind stops, every
+/// instance's pose agrees within 1e-4 × height, and the copies still move, each its own way.
+#[test]
+fn zioma_instances_ring_down_on_the_gpu_as_on_the_cpu() {
+    use sylva_core::methods::Method;
+    use sylva_core::methods::zioma::ZiomaInstance;
+    use sylva_core::pose::SeamPose;
+    let Some(ctx) = common::gpu() else { return };
+    let instances = ZiomaInstance::grid(9, 40.0, 5);
+    let (t, z, s, mut gpu) = gusty_then_calm(ctx, &instances);
+    let mut seam = SeamPose::default();
+    assert!(z.seam_instances(&t, &sylva_core::wind::PackedWind::calm(), &s, &instances, &mut seam));
+    let got = gpu.poses(ctx, s.time).unwrap();
+    for (k, g) in got.iter().enumerate() {
+        let cpu = seam.pose(&t, k);
+        compare(&t, &cpu, g, &format!("instance {k}, a second into the calm"));
+        assert_ne!(cpu, Pose::rest(&t), "instance {k} does not ring");
+    }
+    assert_ne!(got[0].start, got[1].start, "the copies ring alike");
 }
 
 #[test]
@@ -298,16 +331,17 @@ fn zioma_instances_match_and_sway_independently() {
 }
 
 /// The frame kernel (`zioma_frames.wgsl`) against its CPU twin, on every wind preset, three
-/// trees, random instances (±300 m, any yaw), random rings and random times up to 600 s.
+/// trees, random instances (±300 m, any yaw), each with its own random ring (or none) and
+/// random times up to 600 s.
 /// Tolerances: the lean direction within 2e-4 rad, the trunk angles within 1e-5 rad and
 /// their rate within 1e-3 rad/s, each plus how far the CPU's own value moves when the time
 /// moves by two f32 ulps (as [`time_rounding_allowance`]: a GPU that fuses `ω t + φ` rounds
 /// the wind's phases differently); the heading within 1e-6, the rest of the record bit for
-/// bit. Lavapipe, 2026-12-03: 4.4e-5 rad, 1.9e-7 rad and 1.2e-5 rad/s at worst.
+/// bit. Lavapipe, 2026-12-04: 2.1e-5 rad, 1.9e-7 rad and 1.2e-5 rad/s at worst.
 #[test]
 fn zioma_frames_match_their_cpu_twin() {
     use sylva_core::methods::zioma::frames::zioma_frames;
-    use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaInstance, Ring};
+    use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaInstance, RawZiomaRing, Ring};
     let Some(ctx) = common::gpu() else { return };
     let mut rng = rand::rngs::StdRng::seed_from_u64(31);
     let mut worst = [0.0f32; 3];
@@ -329,22 +363,25 @@ fn zioma_frames_match_their_cpu_twin() {
                 .collect();
             for round in 0..3 {
                 let time = rng.random_range(0.0..600.0);
-                let ring = if round == 0 {
-                    Ring::default()
-                } else {
-                    let v = |rng: &mut rand::rngs::StdRng, s: f32| {
-                        Vec3::new(rng.random_range(-s..s), 0.0, rng.random_range(-s..s))
-                    };
-                    Ring {
-                        bend: v(&mut rng, 0.1),
-                        rate: v(&mut rng, 0.5),
-                        since: time - rng.random_range(0.0..10.0),
-                        zeta: rng.random_range(0.02..0.3),
-                    }
-                };
+                let rings: Vec<RawZiomaRing> = (0..instances.len())
+                    .map(|_| {
+                        if round == 0 || rng.random_bool(0.2) {
+                            return RawZiomaRing::from(&Ring::default());
+                        }
+                        let v = |rng: &mut rand::rngs::StdRng, s: f32| {
+                            Vec3::new(rng.random_range(-s..s), 0.0, rng.random_range(-s..s))
+                        };
+                        RawZiomaRing::from(&Ring {
+                            bend: v(&mut rng, 0.1),
+                            rate: v(&mut rng, 0.5),
+                            since: time - rng.random_range(0.0..10.0),
+                            zeta: rng.random_range(0.02..0.3),
+                        })
+                    })
+                    .collect();
                 let cpu_at = |time: f32| {
                     let mut out = vec![<RawZiomaFrame as bytemuck::Zeroable>::zeroed(); instances.len()];
-                    zioma_frames(&packed.fields, &packed.waves, &[z.raw_trunk(time, &ring)], &instances, &mut out);
+                    zioma_frames(&packed.fields, &packed.waves, &[z.raw_trunk(time)], &instances, &rings, &mut out);
                     out
                 };
                 let cpu = cpu_at(time);
@@ -353,12 +390,13 @@ fn zioma_frames_match_their_cpu_twin() {
                 let gpu = sylva_gpu::methods::zioma::frames::zioma_frames(
                     ctx,
                     &gpu_wind,
-                    &z.raw_trunk(time, &ring),
+                    &z.raw_trunk(time),
                     &instances,
+                    &rings,
                 )
                 .unwrap();
                 for (k, (a, b)) in cpu.iter().zip(&gpu).enumerate() {
-                    let what = format!("{name}, {species}, instance {k}, t = {time} s, ring {ring:?}");
+                    let what = format!("{name}, {species}, instance {k}, t = {time} s, ring {:?}", rings[k]);
                     let spread =
                         |f: &dyn Fn(&RawZiomaFrame) -> f32| (f(a) - f(&early[k])).abs().max((f(a) - f(&late[k])).abs());
                     let dir = |f: &RawZiomaFrame| Vec3::from_array(f.wind_dir);

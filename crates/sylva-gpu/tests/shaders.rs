@@ -253,7 +253,7 @@ fn animation_structs_match_their_wgsl_twins() {
     use sylva_core::methods::skjermo::{
         RawSkjermoMode, RawSkjermoState, RawSkjermoStem, RawSkjermoStep, RawSkjermoSway,
     };
-    use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaInstance, RawZiomaStem, RawZiomaTrunk};
+    use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaInstance, RawZiomaRing, RawZiomaStem, RawZiomaTrunk};
     use sylva_gpu::shaders::{AKAGI, NOISE, QUAT, SKJERMO, TREE, WIND, ZIOMA, ZIOMA_ROTATIONS};
     let zioma = compose(&[QUAT, TREE, NOISE, WIND, ZIOMA, ZIOMA_ROTATIONS]);
     check_in(
@@ -263,22 +263,29 @@ fn animation_structs_match_their_wgsl_twins() {
         &[
             ("crown_centre", offset_of!(RawZiomaTrunk, crown_centre)),
             ("natural_frequency", offset_of!(RawZiomaTrunk, natural_frequency)),
-            ("ring_bend", offset_of!(RawZiomaTrunk, ring_bend)),
             ("tip_per_pascal", offset_of!(RawZiomaTrunk, tip_per_pascal)),
-            ("ring_rate", offset_of!(RawZiomaTrunk, ring_rate)),
             ("pressure_centre", offset_of!(RawZiomaTrunk, pressure_centre)),
             ("lever", offset_of!(RawZiomaTrunk, lever)),
             ("damping_ratio", offset_of!(RawZiomaTrunk, damping_ratio)),
             ("reconfiguration_speed", offset_of!(RawZiomaTrunk, reconfiguration_speed)),
             ("vogel_exponent", offset_of!(RawZiomaTrunk, vogel_exponent)),
-            ("ring_since", offset_of!(RawZiomaTrunk, ring_since)),
-            ("ring_zeta", offset_of!(RawZiomaTrunk, ring_zeta)),
             ("time", offset_of!(RawZiomaTrunk, time)),
             ("tree_seed", offset_of!(RawZiomaTrunk, tree_seed)),
             ("lod", offset_of!(RawZiomaTrunk, lod)),
             ("amplitude", offset_of!(RawZiomaTrunk, amplitude)),
             ("max_bend", offset_of!(RawZiomaTrunk, max_bend)),
             ("inertia", offset_of!(RawZiomaTrunk, inertia)),
+        ],
+    );
+    check_in(
+        ZIOMA,
+        "ZiomaRing",
+        size_of::<RawZiomaRing>(),
+        &[
+            ("bend", offset_of!(RawZiomaRing, bend)),
+            ("since", offset_of!(RawZiomaRing, since)),
+            ("rate", offset_of!(RawZiomaRing, rate)),
+            ("zeta", offset_of!(RawZiomaRing, zeta)),
         ],
     );
     check_in(

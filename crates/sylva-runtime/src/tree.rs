@@ -418,7 +418,11 @@ impl WorldTree {
                 })
                 .collect();
             let n = placements.len() * tree.segments.len();
-            let sim = build_sim(&wind.clock(ctx, 0.0)?, &placements)?;
+            let mut sim = build_sim(&wind.clock(ctx, 0.0)?, &placements)?;
+            if let Simulation::Cpu(a) = &mut sim {
+                // Methods with per-instance state (Zioma's rings) keep one for each copy.
+                a.set_instances(&placements);
+            }
             Drawn::Forest(Box::new(Forest {
                 sim,
                 transforms: Renderer::instances(ctx, &inst),

@@ -133,6 +133,10 @@ pub trait Method: Debug + Send + Sync + 'static {
         false
     }
 
+    /// Registers the instances [`Self::seam_instances`] will pose, for methods that keep
+    /// state per instance (Zioma's rings); the others ignore it.
+    fn set_instances(&self, _tree: &Tree, _state: &mut Self::State, _instances: &[Placement]) {}
+
     /// Debug data: the centres of the method's clusters, in the tree's frame.
     fn cluster_centres(&self, _state: &Self::State) -> Option<Vec<Vec3>> {
         None
@@ -174,6 +178,8 @@ pub trait Animator: Debug + Send + Sync {
     fn curves(&self) -> Option<Curves<'_>>;
     /// See [`Method::seam_instances`].
     fn seam_instances(&self, instances: &[Placement], out: &mut SeamPose) -> bool;
+    /// See [`Method::set_instances`].
+    fn set_instances(&mut self, instances: &[Placement]);
     /// See [`Method::cluster_centres`].
     fn cluster_centres(&self) -> Option<Vec<Vec3>>;
     /// See [`Method::particles`].
@@ -187,13 +193,15 @@ pub struct Simulation<M: Method> {
     method: M,
     state: M::State,
     wind: Arc<PackedWind>,
+    /// The instances registered ([`Animator::set_instances`]), kept across a reset.
+    instances: Vec<Placement>,
 }
 
 impl<M: Method> Simulation<M> {
     /// The method at rest in still air.
     pub fn new(tree: Arc<Tree>, method: M) -> Self {
         let state = method.rest_state(&tree);
-        Self { tree, method, state, wind: Arc::new(PackedWind::calm()) }
+        Self { tree, method, state, wind: Arc::new(PackedWind::calm()), instances: Vec::new() }
     }
 
     /// Boxed as an [`Animator`].
@@ -233,6 +241,7 @@ impl<M: Method> Animator for Simulation<M> {
     fn reset(&mut self, time: f32) {
         self.state = self.method.rest_state(&self.tree);
         self.method.set_time(&mut self.state, time);
+        self.method.set_instances(&self.tree, &mut self.state, &self.instances);
     }
     fn step(&mut self, dt: f32) {
         self.method.step(&self.tree, &self.wind, &mut self.state, dt);
@@ -251,6 +260,10 @@ impl<M: Method> Animator for Simulation<M> {
     }
     fn seam_instances(&self, instances: &[Placement], out: &mut SeamPose) -> bool {
         self.method.seam_instances(&self.tree, &self.wind, &self.state, instances, out)
+    }
+    fn set_instances(&mut self, instances: &[Placement]) {
+        self.instances = instances.to_vec();
+        self.method.set_instances(&self.tree, &mut self.state, instances);
     }
     fn cluster_centres(&self) -> Option<Vec<Vec3>> {
         self.method.cluster_centres(&self.state)

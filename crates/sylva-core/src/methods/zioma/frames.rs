@@ -1,12 +1,12 @@
 //! Every instance's per-frame values as a kernel (Zioma §6.3.3, §6.5): the wind at the
-//! instance's crown through the trunk's oscillator ([`TrunkModel::bend`]) plus the ring it
-//! rings by, turned into the tree's frame, the lean's direction, its noise bands
+//! instance's crown through the trunk's oscillator ([`TrunkModel::bend`]) plus the
+//! instance's own ring, turned into the tree's frame, the lean's direction, its noise bands
 //! ([`TrunkNoise`]) and the parallel band's rate by a central difference. CPU twin of
 //! `zioma_frames.wgsl`; [`super::Zioma::frames_for`] runs it, so the CPU method and the GPU
 //! compute the same thing in the same order (to the device's rounding of `sin`, `pow`,
 //! `exp` and `atan2`).
 
-use super::raw::{RawZiomaFrame, RawZiomaInstance, RawZiomaTrunk};
+use super::raw::{RawZiomaFrame, RawZiomaInstance, RawZiomaRing, RawZiomaTrunk};
 use super::trunk::{self, Ring, TrunkModel, TrunkNoise};
 use crate::physics::DragModel;
 use crate::pose::Placement;
@@ -29,15 +29,11 @@ impl RawZiomaTrunk {
             drag: DragModel { reconfiguration_speed: self.reconfiguration_speed, vogel_exponent: self.vogel_exponent },
         }
     }
+}
 
-    /// The ring it carries.
-    pub fn ring(&self) -> Ring {
-        Ring {
-            bend: Vec3::from_array(self.ring_bend),
-            rate: Vec3::from_array(self.ring_rate),
-            since: self.ring_since,
-            zeta: self.ring_zeta,
-        }
+impl From<&RawZiomaRing> for Ring {
+    fn from(r: &RawZiomaRing) -> Self {
+        Ring { bend: Vec3::from_array(r.bend), rate: Vec3::from_array(r.rate), since: r.since, zeta: r.zeta }
     }
 }
 
@@ -47,9 +43,15 @@ impl From<&RawZiomaInstance> for Placement {
     }
 }
 
-/// One instance's frame values.
-pub fn zioma_frame(fields: &[RawField], waves: &[RawWave], k: &RawZiomaTrunk, i: &RawZiomaInstance) -> RawZiomaFrame {
-    let (model, ring, place) = (k.model(), k.ring(), Placement::from(i));
+/// One instance's frame values, ringing by `r`.
+pub fn zioma_frame(
+    fields: &[RawField],
+    waves: &[RawWave],
+    k: &RawZiomaTrunk,
+    i: &RawZiomaInstance,
+    r: &RawZiomaRing,
+) -> RawZiomaFrame {
+    let (model, ring, place) = (k.model(), Ring::from(r), Placement::from(i));
     let centre = place.to_world(Vec3::from_array(k.crown_centre));
     let seed = k.tree_seed ^ i.seed;
     // The trunk's lean (its oscillator's answer to the wind, horizontal, in the tree's
@@ -82,14 +84,18 @@ pub fn zioma_frame(fields: &[RawField], waves: &[RawWave], k: &RawZiomaTrunk, i:
 }
 
 /// The kernel's CPU twin. Bindings as in `zioma_frames.wgsl`: 0 = fields, 1 = waves,
-/// 2 = the tree's values (one), 3 = instances, 4 = frames (one per instance).
+/// 2 = the tree's values (one), 3 = instances, 4 = their rings, 5 = frames (one per
+/// instance).
 pub fn zioma_frames(
     fields: &[RawField],
     waves: &[RawWave],
     trunk: &[RawZiomaTrunk],
     instances: &[RawZiomaInstance],
+    rings: &[RawZiomaRing],
     out: &mut [RawZiomaFrame],
 ) {
     let k = &trunk[0];
-    out.par_iter_mut().zip(instances.par_iter()).for_each(|(o, i)| *o = zioma_frame(fields, waves, k, i));
+    out.par_iter_mut()
+        .zip(instances.par_iter().zip(rings.par_iter()))
+        .for_each(|(o, (i, r))| *o = zioma_frame(fields, waves, k, i, r));
 }

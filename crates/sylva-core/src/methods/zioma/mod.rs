@@ -4,8 +4,10 @@
 //! the wind has changed, of the trunk's ring-down since ([`trunk::Ring`], a closed form in
 //! t too). The stateless entry points ([`Zioma::pose_at`], [`Zioma::rotations_packed`],
 //! [`Zioma::rotations_instances`]) take the wind as blowing since t = 0 from still air: the
-//! tree starts upright and swings into its lean. Instances share the ring taken at the tree's
-//! own crown.
+//! tree starts upright and swings into its lean. Each instance rings by its own ring, taken
+//! at its own crown (the wind differs from one to the next), so a forest's trunks stay
+//! continuous when the wind changes; the state keeps them for the instances registered with
+//! [`Method::set_instances`].
 //!
 //! * **Trunk** (§6.3.3, Ota 2003): the wind at the crown's centre passed wave by wave through
 //!   a damped oscillator at the trunk's own frequency ([`trunk`]); the trunk leans by that
@@ -45,6 +47,7 @@ use crate::wind::WindScene;
 use crate::wind::raw::{RawField, RawWave};
 use bytemuck::Zeroable;
 use glam::Vec3;
+use rayon::prelude::*;
 use rotations::zioma_rotations;
 use std::sync::Arc;
 pub use trunk::Ring;
@@ -96,15 +99,19 @@ impl ZiomaParams {
 }
 
 /// Zioma's state: the time, and the trunk's ring-down since the wind last changed (the pose
-/// is a closed form in t).
+/// is a closed form in t), the tree's and each registered instance's.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ZiomaState {
     /// Time, s.
     pub time: f32,
-    /// The trunk's ring-down since the wind last changed.
+    /// The trunk's ring-down since the wind last changed (the tree at the origin).
     pub ring: Ring,
     /// The wind the last step took (`None`: still air, not yet stepped).
     pub wind: Option<PackedWind>,
+    /// The instances registered with [`Method::set_instances`].
+    pub instances: Vec<Placement>,
+    /// Each registered instance's ring, taken at its own crown.
+    pub rings: Vec<Ring>,
 }
 
 /// The registry's CPU constructor: Zioma's method on `tree` with `options`.
@@ -188,9 +195,46 @@ impl Zioma {
         self.trunk.ring_after((&old.fields, &old.waves), (&new.fields, &new.waves), ring, self.crown_centre, t)
     }
 
+    /// [`Self::ring_after`] for `instance`, taken at its own crown.
+    pub fn instance_ring_after(
+        &self,
+        old: &PackedWind,
+        new: &PackedWind,
+        ring: &Ring,
+        instance: &ZiomaInstance,
+        t: f32,
+    ) -> Ring {
+        let crown = instance.to_world(self.crown_centre);
+        self.trunk.ring_after((&old.fields, &old.waves), (&new.fields, &new.waves), ring, crown, t)
+    }
+
+    /// [`Self::instance_ring_after`] for every instance, each from its own ring in `rings`
+    /// (in parallel).
+    pub fn instance_rings_after(
+        &self,
+        old: &PackedWind,
+        new: &PackedWind,
+        rings: &[Ring],
+        instances: &[ZiomaInstance],
+        t: f32,
+    ) -> Vec<Ring> {
+        instances.par_iter().zip(rings).map(|(i, r)| self.instance_ring_after(old, new, r, i, t)).collect()
+    }
+
     /// The ring of a wind blowing since t = 0 from still air.
     pub fn start_ring(&self, fields: &[RawField], waves: &[RawWave]) -> Ring {
         self.trunk.ring_after((&[], &[]), (fields, waves), &Ring::default(), self.crown_centre, 0.0)
+    }
+
+    /// Every instance's ring of a wind blowing since t = 0 from still air.
+    pub fn start_rings(&self, fields: &[RawField], waves: &[RawWave], instances: &[ZiomaInstance]) -> Vec<Ring> {
+        instances
+            .par_iter()
+            .map(|i| {
+                let crown = i.to_world(self.crown_centre);
+                self.trunk.ring_after((&[], &[]), (fields, waves), &Ring::default(), crown, 0.0)
+            })
+            .collect()
     }
 
     /// The per-frame values at time `t`: wind at the crown, trunk angles and their rate (the
@@ -199,23 +243,19 @@ impl Zioma {
         self.frame_for(fields, waves, t, None, ring)
     }
 
-    /// The tree's values for a frame at time `t`, ringing by `ring` (what the frame kernel
-    /// reads beside each instance).
-    pub fn raw_trunk(&self, t: f32, ring: &Ring) -> RawZiomaTrunk {
+    /// The tree's values for a frame at time `t` (what the frame kernel reads beside each
+    /// instance and its ring).
+    pub fn raw_trunk(&self, t: f32) -> RawZiomaTrunk {
         let m = &self.trunk;
         RawZiomaTrunk {
             crown_centre: self.crown_centre.to_array(),
             natural_frequency: m.natural_frequency,
-            ring_bend: ring.bend.to_array(),
             tip_per_pascal: m.tip_per_pascal,
-            ring_rate: ring.rate.to_array(),
             pressure_centre: m.pressure_centre,
             lever: m.lever,
             damping_ratio: m.damping_ratio,
             reconfiguration_speed: m.drag.reconfiguration_speed,
             vogel_exponent: m.drag.vogel_exponent,
-            ring_since: ring.since,
-            ring_zeta: ring.zeta,
             time: t,
             tree_seed: self.tree_seed,
             lod: (self.params.lod == Lod::Full) as u32,
@@ -235,22 +275,24 @@ impl Zioma {
         ring: &Ring,
     ) -> RawZiomaFrame {
         let instance = instance.map_or(RawZiomaInstance::zeroed(), RawZiomaInstance::from);
-        frames::zioma_frame(fields, waves, &self.raw_trunk(t, ring), &instance)
+        frames::zioma_frame(fields, waves, &self.raw_trunk(t), &instance, &ring.into())
     }
 
-    /// The per-frame values of every instance (in parallel; each on its own), by the frame
-    /// kernel's CPU twin ([`frames::zioma_frames`]).
+    /// The per-frame values of every instance, each ringing by its own ring in `rings` (in
+    /// parallel; each on its own), by the frame kernel's CPU twin ([`frames::zioma_frames`]).
     pub fn frames_for(
         &self,
         fields: &[RawField],
         waves: &[RawWave],
         t: f32,
         instances: &[ZiomaInstance],
-        ring: &Ring,
+        rings: &[Ring],
     ) -> Vec<RawZiomaFrame> {
+        assert_eq!(instances.len(), rings.len(), "one ring per instance");
         let raw: Vec<RawZiomaInstance> = instances.iter().map(RawZiomaInstance::from).collect();
+        let rings: Vec<RawZiomaRing> = rings.iter().map(RawZiomaRing::from).collect();
         let mut out = vec![RawZiomaFrame::zeroed(); raw.len()];
-        frames::zioma_frames(fields, waves, &[self.raw_trunk(t, ring)], &raw, &mut out);
+        frames::zioma_frames(fields, waves, &[self.raw_trunk(t)], &raw, &rings, &mut out);
         out
     }
 
@@ -265,10 +307,10 @@ impl Zioma {
         t: f32,
         instances: &[ZiomaInstance],
     ) -> Vec<[f32; 4]> {
-        self.rotations_instances_ringing(tree, fields, waves, t, instances, &self.start_ring(fields, waves))
+        self.rotations_instances_ringing(tree, fields, waves, t, instances, &self.start_rings(fields, waves, instances))
     }
 
-    /// [`Self::rotations_instances`] ringing by `ring`.
+    /// [`Self::rotations_instances`], each instance ringing by its own ring in `rings`.
     pub fn rotations_instances_ringing(
         &self,
         tree: &Tree,
@@ -276,9 +318,9 @@ impl Zioma {
         waves: &[RawWave],
         t: f32,
         instances: &[ZiomaInstance],
-        ring: &Ring,
+        rings: &[Ring],
     ) -> Vec<[f32; 4]> {
-        let frames = self.frames_for(fields, waves, t, instances, ring);
+        let frames = self.frames_for(fields, waves, t, instances, rings);
         let mut out = vec![[0.0; 4]; tree.segments.len() * instances.len()];
         zioma_rotations(fields, waves, &self.raw, &self.stems, &frames, &mut out);
         out
@@ -310,6 +352,23 @@ impl Zioma {
         out
     }
 
+    /// Each of `instances`' rings in `wind`: a registered instance's own (an unregistered one
+    /// takes the tree's), or, if the last step took another wind, the ring of a change to
+    /// `wind` now, at the instance's crown.
+    fn current_rings(&self, state: &ZiomaState, wind: &PackedWind, instances: &[Placement]) -> Vec<Ring> {
+        let rings: Vec<Ring> = (0..instances.len())
+            .map(|k| match (state.instances.get(k), state.rings.get(k)) {
+                (Some(p), Some(ring)) if *p == instances[k] => *ring,
+                _ => state.ring,
+            })
+            .collect();
+        match &state.wind {
+            Some(w) if w == wind => rings,
+            Some(w) => self.instance_rings_after(w, wind, &rings, instances, state.time),
+            None => self.instance_rings_after(&PackedWind::calm(), wind, &rings, instances, state.time),
+        }
+    }
+
     /// The state's ring in `wind`: its own if the last step took that wind, else the ring of a
     /// change to it now.
     fn current_ring(&self, state: &ZiomaState, wind: &PackedWind) -> Ring {
@@ -337,13 +396,29 @@ impl Method for Zioma {
         ZiomaState::default()
     }
 
-    /// Advances the time; a wind unlike the last step's starts a ring at the current time.
+    /// Advances the time; a wind unlike the last step's starts a ring at the current time,
+    /// the tree's and each registered instance's.
     fn step(&self, _tree: &Tree, wind: &PackedWind, state: &mut ZiomaState, dt: f32) {
         if state.wind.as_ref() != Some(wind) {
+            state.rings = self.current_rings(state, wind, &state.instances);
             state.ring = self.current_ring(state, wind);
             state.wind = Some(wind.clone());
         }
         state.time += dt;
+    }
+
+    /// Registers the instances [`Method::seam_instances`] will pose, so each keeps its own
+    /// ring from the next wind change on; one registered before the first step is exact
+    /// from the start. An instance new to the state takes the tree's ring until then.
+    fn set_instances(&self, _tree: &Tree, state: &mut ZiomaState, instances: &[Placement]) {
+        let rings = (0..instances.len())
+            .map(|k| match (state.instances.get(k), state.rings.get(k)) {
+                (Some(old), Some(ring)) if *old == instances[k] => *ring,
+                _ => state.ring,
+            })
+            .collect();
+        state.instances = instances.to_vec();
+        state.rings = rings;
     }
 
     fn time(&self, state: &ZiomaState) -> f32 {
@@ -374,8 +449,8 @@ impl Method for Zioma {
         instances: &[Placement],
         out: &mut SeamPose,
     ) -> bool {
-        let ring = self.current_ring(state, wind);
-        let delta = self.rotations_instances_ringing(tree, &wind.fields, &wind.waves, state.time, instances, &ring);
+        let rings = self.current_rings(state, wind, instances);
+        let delta = self.rotations_instances_ringing(tree, &wind.fields, &wind.waves, state.time, instances, &rings);
         *out = SeamPose::from_rotations(tree, &delta);
         // The first instance's leaves (every copy's, as skinning shares them).
         let n = tree.segments.len().min(out.joints.len());

@@ -61,10 +61,9 @@ pub struct RawZiomaFrame {
     pub _pad: [f32; 2],
 }
 
-/// One tree's values for a frame, 96 bytes: its trunk ([`super::trunk::TrunkModel`]), the
-/// ring it is ringing by ([`super::Ring`]), the time and the method's parameters. WGSL:
-/// `ZiomaTrunk` in `zioma.wgsl`; the frame kernel ([`super::frames`]) reads it once for every
-/// instance.
+/// One tree's values for a frame, 64 bytes: its trunk ([`super::trunk::TrunkModel`]), the
+/// time and the method's parameters. WGSL: `ZiomaTrunk` in `zioma.wgsl`; the frame kernel
+/// ([`super::frames`]) reads it once for every instance.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawZiomaTrunk {
@@ -72,12 +71,8 @@ pub struct RawZiomaTrunk {
     pub crown_centre: [f32; 3],
     /// First-mode frequency f₀, Hz.
     pub natural_frequency: f32,
-    /// The ring's bend at its change, rad (scene frame).
-    pub ring_bend: [f32; 3],
     /// Trunk-top deflection per pascal on the crown, m/Pa.
     pub tip_per_pascal: f32,
-    /// The ring's rate of bend at its change, rad/s.
-    pub ring_rate: [f32; 3],
     /// Centre of pressure, share of the tip's motion.
     pub pressure_centre: f32,
     /// Trunk-top motion per radian of arc, m.
@@ -88,10 +83,6 @@ pub struct RawZiomaTrunk {
     pub reconfiguration_speed: f32,
     /// Vogel exponent B.
     pub vogel_exponent: f32,
-    /// Time of the ring's change, s.
-    pub ring_since: f32,
-    /// The ring's damping ratio.
-    pub ring_zeta: f32,
     /// Time of the frame, s.
     pub time: f32,
     /// Seed of the tree's trunk noise (an instance's seed is XORed in).
@@ -104,6 +95,27 @@ pub struct RawZiomaTrunk {
     pub max_bend: f32,
     /// Inertia gain.
     pub inertia: f32,
+}
+
+/// One instance's ring ([`super::Ring`]: the trunk's free ring-down since the wind last
+/// changed, taken at the instance's own crown), 32 bytes. WGSL: `ZiomaRing` in `zioma.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RawZiomaRing {
+    /// Bend at the change, rad (scene frame).
+    pub bend: [f32; 3],
+    /// Time of the change, s.
+    pub since: f32,
+    /// Rate of bend at the change, rad/s.
+    pub rate: [f32; 3],
+    /// Damping ratio in the new wind.
+    pub zeta: f32,
+}
+
+impl From<&super::Ring> for RawZiomaRing {
+    fn from(r: &super::Ring) -> Self {
+        Self { bend: r.bend.to_array(), since: r.since, rate: r.rate.to_array(), zeta: r.zeta }
+    }
 }
 
 /// A placed instance ([`crate::pose::Placement`]) as the frame kernel reads it, 32 bytes.

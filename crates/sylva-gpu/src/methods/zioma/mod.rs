@@ -1,7 +1,8 @@
 //! Zioma's method on the GPU: every instance's frame values from `zioma_frames.wgsl`, the
 //! rotations from `zioma_rotations.wgsl`, the pose from [`GpuPose`], every instance in one
-//! submission per frame (§6.5 instancing). The CPU writes 96 bytes a frame (the tree's
-//! [`RawZiomaTrunk`]: the time and the ring), whatever the number of instances.
+//! submission per frame (§6.5 instancing). The CPU writes 64 bytes a frame (the tree's
+//! [`RawZiomaTrunk`] with the time), whatever the number of instances; each instance's
+//! ring, taken at its own crown, is computed and uploaded when the wind changes.
 
 pub mod frames;
 pub mod trunk_noise;
@@ -15,7 +16,7 @@ use crate::{GpuContext, GpuError};
 use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::methods::MethodOptions;
-use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaInstance, RawZiomaTrunk, Ring, Zioma, ZiomaParams};
+use sylva_core::methods::zioma::{RawZiomaFrame, RawZiomaInstance, RawZiomaRing, Ring, Zioma, ZiomaParams};
 use sylva_core::pose::{Placement, Pose};
 
 /// Zioma's method on the GPU for one tree and its placed instances.
@@ -31,15 +32,22 @@ pub struct GpuZioma {
     stems: wgpu::Buffer,
     /// The tree's values for the frame ([`RawZiomaTrunk`]), written each frame.
     trunk: wgpu::Buffer,
-    /// The instances ([`RawZiomaInstance`]; one unturned at the origin for a single tree).
+    /// The instances (one unturned at the origin for a single tree).
+    instances: Vec<Placement>,
+    /// As the kernel reads them ([`RawZiomaInstance`]).
     placements: wgpu::Buffer,
+    /// Each instance's ring ([`RawZiomaRing`]), written when the wind changes.
+    ring_buffer: wgpu::Buffer,
     /// One [`RawZiomaFrame`] per instance, written by the frame kernel.
     frame: wgpu::Buffer,
     leaves: GpuLeafFlutter,
     /// The frame and rotation kernels, bound on first use after the wind is set.
     rotations: Option<Plan>,
-    /// The trunk's ring-down since the wind last changed (as the CPU's state).
-    ring: Ring,
+    /// Each instance's ring-down since the wind last changed, taken at its crown (as the
+    /// CPU's state).
+    rings: Vec<Ring>,
+    /// The rings changed since they were last uploaded.
+    rings_changed: bool,
     /// Time of the pose, s.
     pub time: f32,
 }
@@ -60,24 +68,25 @@ impl GpuZioma {
         wind: &GpuWind,
         instances: &[Placement],
     ) -> Result<Self, GpuError> {
-        let count = instances.len().max(1);
+        let instances = if instances.is_empty() { vec![Placement::default()] } else { instances.to_vec() };
+        let count = instances.len();
         let zeroed: RawZiomaFrame = bytemuck::Zeroable::zeroed();
-        let mut placements: Vec<RawZiomaInstance> = instances.iter().map(RawZiomaInstance::from).collect();
-        if placements.is_empty() {
-            placements.push(bytemuck::Zeroable::zeroed());
-        }
-        let ring = method.start_ring(&wind.packed.fields, &wind.packed.waves);
-        let trunk: RawZiomaTrunk = method.raw_trunk(0.0, &ring);
+        let placements: Vec<RawZiomaInstance> = instances.iter().map(RawZiomaInstance::from).collect();
+        let rings = method.start_rings(&wind.packed.fields, &wind.packed.waves, &instances);
+        let raw_rings: Vec<RawZiomaRing> = rings.iter().map(RawZiomaRing::from).collect();
         Ok(Self {
-            ring,
+            rings,
+            rings_changed: false,
             frames_kernel: Kernel::get(ctx, "zioma_frames"),
             kernel: Kernel::get(ctx, "zioma_rotations"),
             pose: GpuPose::with_instances(ctx, &tree, count)?,
             wind: wind.clone(),
             segments: upload(ctx, "segments", &tree.raw_segments())?,
             stems: upload(ctx, "zioma stems", &method.stems)?,
-            trunk: upload(ctx, "zioma trunk", &[trunk])?,
+            trunk: upload(ctx, "zioma trunk", &[method.raw_trunk(0.0)])?,
             placements: upload(ctx, "zioma instances", &placements)?,
+            ring_buffer: upload(ctx, "zioma rings", &raw_rings)?,
+            instances,
             frame: upload(ctx, "zioma frames", &vec![zeroed; count])?,
             leaves: GpuLeafFlutter::new(ctx, &method.leaves)?,
             rotations: None,
@@ -104,11 +113,17 @@ impl GpuZioma {
     /// the queue now, so record one pose per submission.
     pub fn record(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, t: f32) {
         self.time = t;
-        let trunk = self.method.raw_trunk(t, &self.ring);
+        if self.rings_changed {
+            let raw: Vec<RawZiomaRing> = self.rings.iter().map(RawZiomaRing::from).collect();
+            ctx.queue.write_buffer(&self.ring_buffer, 0, bytemuck::cast_slice(&raw));
+            self.rings_changed = false;
+        }
+        let trunk = self.method.raw_trunk(t);
         ctx.queue.write_buffer(&self.trunk, 0, bytemuck::bytes_of(&trunk));
         let plan = self.rotations.get_or_insert_with(|| {
             let mut plan = Plan::default();
-            let buffers = [&self.wind.fields, &self.wind.waves, &self.trunk, &self.placements, &self.frame];
+            let buffers =
+                [&self.wind.fields, &self.wind.waves, &self.trunk, &self.placements, &self.ring_buffer, &self.frame];
             plan.push(ctx, &self.frames_kernel, &buffers, self.pose.instance_count() as u32);
             let buffers = [
                 &self.wind.fields,
@@ -163,7 +178,9 @@ impl GpuAnimator for GpuZioma {
     /// A wind unlike the last starts a ring at the current time, as on the CPU.
     fn set_wind(&mut self, wind: &GpuWind) {
         if *wind.packed != *self.wind.packed {
-            self.ring = self.method.ring_after(&self.wind.packed, &wind.packed, &self.ring, self.time);
+            let (m, old) = (&self.method, &self.wind.packed);
+            self.rings = m.instance_rings_after(old, &wind.packed, &self.rings, &self.instances, self.time);
+            self.rings_changed = true;
         }
         self.wind = wind.clone();
         self.rotations = None;

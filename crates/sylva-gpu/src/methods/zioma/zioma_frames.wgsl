@@ -1,13 +1,14 @@
 // zioma_frames: every instance's per-frame values (Zioma §6.3.3, §6.5): the wind at its
-// crown through the trunk's damped oscillator plus the ring, turned into the tree's frame,
+// crown through the trunk's damped oscillator plus its own ring, turned into the tree's frame,
 // the lean's direction, its noise bands and the parallel band's rate. CPU twin:
 // sylva_core::methods::zioma::frames (bindings 0 fields, 1 waves — from wind.wgsl —
-// 2 the tree's values, 3 instances, 4 frames). The trunk's functions are
+// 2 the tree's values, 3 instances, 4 their rings, 5 frames). The trunk's functions are
 // sylva_core::methods::zioma::trunk::TrunkModel's, written out in the same order.
 
 @group(0) @binding(2) var<storage, read> trunk: ZiomaTrunk;
 @group(0) @binding(3) var<storage, read> instances: array<ZiomaInstance>;
-@group(0) @binding(4) var<storage, read_write> frames: array<ZiomaFrame>;
+@group(0) @binding(4) var<storage, read> rings: array<ZiomaRing>;
+@group(0) @binding(5) var<storage, read_write> frames: array<ZiomaFrame>;
 
 const AIR_DENSITY: f32 = 1.225;
 const MAX_TRUNK_BEND: f32 = 0.35;
@@ -126,17 +127,17 @@ fn trunk_bend(p: vec3<f32>, t: f32) -> vec3<f32> {
 }
 
 // The ring's bend at t (TrunkModel::ring_at).
-fn ring_bend(t: f32) -> vec3<f32> {
-    let tau = t - trunk.ring_since;
-    if (tau < 0.0 || (all(trunk.ring_bend == vec3<f32>(0.0)) && all(trunk.ring_rate == vec3<f32>(0.0)))) {
+fn ring_bend(ring: ZiomaRing, t: f32) -> vec3<f32> {
+    let tau = t - ring.since;
+    if (tau < 0.0 || (all(ring.bend == vec3<f32>(0.0)) && all(ring.rate == vec3<f32>(0.0)))) {
         return vec3<f32>(0.0);
     }
     let w = TAU * trunk.natural_frequency;
-    let z = clamp(trunk.ring_zeta, 0.0, 0.95);
+    let z = clamp(ring.zeta, 0.0, 0.95);
     let a = z * w;
     let wd = w * sqrt(1.0 - z * z);
-    let b = (trunk.ring_rate + trunk.ring_bend * a) / wd;
-    return exp(-a * tau) * (trunk.ring_bend * cos(wd * tau) + b * sin(wd * tau));
+    let b = (ring.rate + ring.bend * a) / wd;
+    return exp(-a * tau) * (ring.bend * cos(wd * tau) + b * sin(wd * tau));
 }
 
 // The trunk's noise bands at lean theta (TrunkNoise::new's table, trunk::TRUNK_BANDS):
@@ -153,8 +154,8 @@ fn trunk_noise_angles(theta: f32, t: f32, seed: u32) -> vec3<f32> {
 
 // The lean at t as (unit direction in the tree's frame, or zero; angle θ): sc is the
 // instance's (sin, cos) of yaw.
-fn lean(centre: vec3<f32>, t: f32, sc: vec2<f32>) -> vec4<f32> {
-    let w = trunk_bend(centre, t) + ring_bend(t);
+fn lean(centre: vec3<f32>, ring: ZiomaRing, t: f32, sc: vec2<f32>) -> vec4<f32> {
+    let w = trunk_bend(centre, t) + ring_bend(ring, t);
     let b = vec3<f32>(sc.y * w.x - sc.x * w.z, w.y, sc.x * w.x + sc.y * w.z);
     let l = length(b);
     var dir = vec3<f32>(0.0);
@@ -171,16 +172,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         return;
     }
     let inst = instances[i];
+    let ring = rings[i];
     let sc = vec2<f32>(sin(inst.yaw), cos(inst.yaw));
     let c = trunk.crown_centre;
     let centre = inst.position + vec3<f32>(sc.y * c.x + sc.x * c.z, c.y, -sc.x * c.x + sc.y * c.z);
     let seed = trunk.tree_seed ^ inst.seed;
     let t = trunk.time;
-    let now = lean(centre, t, sc);
+    let now = lean(centre, ring, t, sc);
     let tp = t + RATE_DT;
     let tm = t - RATE_DT;
-    let ahead = trunk_noise_angles(lean(centre, tp, sc).w, tp, seed).x;
-    let behind = trunk_noise_angles(lean(centre, tm, sc).w, tm, seed).x;
+    let ahead = trunk_noise_angles(lean(centre, ring, tp, sc).w, tp, seed).x;
+    let behind = trunk_noise_angles(lean(centre, ring, tm, sc).w, tm, seed).x;
     var f: ZiomaFrame;
     f.wind_dir = now.xyz;
     f.time = t;
