@@ -23,7 +23,7 @@ pub(super) fn leaf_rims(sides: u32) -> Vec<Vec<Uv>> {
 }
 
 impl MeshLayout {
-    /// Bark texture coordinates, one per bark vertex: the rings' ([`ring_uv`]), then each band
+    /// Bark texture coordinates, one per bark vertex: the rings' (`ring_uv`), then each band
     /// midpoint the mean of its edge's two ends.
     pub fn tube_uv(&self) -> Vec<Uv> {
         let info = self.info();

@@ -162,7 +162,7 @@ const RIM_SAMPLES: u32 = 16;
 const RIM_MARGIN: f32 = 1.02;
 
 /// [`LeafShape::rim`] by index: same operations as `leaf_rim` in `leaf_shape.wgsl`. In the
-/// outline stretched by [`leaf_box`] to about a circle, vertex k sits at angle π − k·step
+/// outline stretched by `leaf_box` to about a circle, vertex k sits at angle π − k·step
 /// (from the base through +u); its radius keeps both chords beside it outside every sampled
 /// outline point of their sectors (a chord with both ends at R passes at R cos(φ − mid) /
 /// cos(step / 2) in direction φ, and a longer end only moves it out). Stretching back keeps

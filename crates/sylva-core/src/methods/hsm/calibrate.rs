@@ -19,7 +19,7 @@ const LONGEST: f32 = 20.0;
 /// The trunk's first-mode frequency under `hsm`'s own dynamics at its substep rate, Hz:
 /// half the inverse of the time the trunk top's tail ring takes to reach its first peak
 /// after a step load. `None` without a substep rate, without a trunk cluster, or when no
-/// peak comes within [`LONGEST`] seconds.
+/// peak comes within `LONGEST` seconds.
 pub fn trunk_frequency(tree: &Tree, hsm: &Hsm) -> Option<f32> {
     let rate = hsm.params.substep_rate;
     if rate <= 0.0 {

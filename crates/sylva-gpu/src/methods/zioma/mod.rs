@@ -1,7 +1,7 @@
 //! Zioma's method on the GPU: every instance's frame values from `zioma_frames.wgsl`, the
 //! rotations from `zioma_rotations.wgsl`, the pose from [`GpuPose`], every instance in one
 //! submission per frame (§6.5 instancing). The CPU writes 64 bytes a frame (the tree's
-//! [`RawZiomaTrunk`] with the time), whatever the number of instances; each instance's
+//! [`sylva_core::methods::zioma::RawZiomaTrunk`] with the time), whatever the number of instances; each instance's
 //! ring, taken at its own crown, is computed and uploaded when the wind changes.
 
 pub mod frames;
@@ -30,7 +30,7 @@ pub struct GpuZioma {
     wind: GpuWind,
     segments: wgpu::Buffer,
     stems: wgpu::Buffer,
-    /// The tree's values for the frame ([`RawZiomaTrunk`]), written each frame.
+    /// The tree's values for the frame ([`sylva_core::methods::zioma::RawZiomaTrunk`]), written each frame.
     trunk: wgpu::Buffer,
     /// The instances (one unturned at the origin for a single tree).
     instances: Vec<Placement>,
