@@ -79,28 +79,56 @@ fn digest(tree: &Tree, method: &str) -> String {
     format!("{:x}", h.finalize())
 }
 
-#[test]
-fn cpu_simulations_match_their_pinned_digests_on_1_and_3_threads() {
+/// Checks the pinned line of `preset` and `method`: the same digest on one thread and on
+/// three, and the pinned one (or, with `SYLVA_BLESS`, prints it).
+fn check(preset: &str, method: &str) {
     let pinned = include_str!("simulation_digests.txt");
-    let bless = std::env::var("SYLVA_BLESS").is_ok();
-    let mut checked = 0;
-    for line in pinned.lines().filter(|l| !l.trim().is_empty() && !l.starts_with('#')) {
-        let mut it = line.split_whitespace();
-        let (preset, seed, method, want) =
-            (it.next().unwrap(), it.next().unwrap().parse::<u64>().unwrap(), it.next().unwrap(), it.next().unwrap());
-        let tree = SpeciesSource::resolve(preset).unwrap().generate(seed, &Default::default(), None).unwrap();
-        let mut got = Vec::new();
-        for threads in [1, 3] {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            got.push(pool.install(|| digest(&tree, method)));
-        }
-        assert_eq!(got[0], got[1], "{preset} {method}: the simulation depends on the thread count");
-        if bless {
-            println!("{preset} {seed} {method} {}", got[0]);
-        } else {
-            assert_eq!(got[0], want, "{preset} seed {seed} {method}: the simulation changed (see the module docs)");
-        }
-        checked += 1;
+    let line = pinned
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
+        .map(|l| l.split_whitespace().collect::<Vec<_>>())
+        .find(|f| f[0] == preset && f[2] == method)
+        .unwrap_or_else(|| panic!("simulation_digests.txt has no line for {preset} {method}"));
+    let (seed, want) = (line[1].parse::<u64>().unwrap(), line[3]);
+    let tree = SpeciesSource::resolve(preset).unwrap().generate(seed, &Default::default(), None).unwrap();
+    let mut got = Vec::new();
+    for threads in [1, 3] {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        got.push(pool.install(|| digest(&tree, method)));
     }
-    assert_eq!(checked, 8, "two presets × four methods");
+    assert_eq!(got[0], got[1], "{preset} {method}: the simulation depends on the thread count");
+    if std::env::var("SYLVA_BLESS").is_ok() {
+        println!("{preset} {seed} {method} {}", got[0]);
+    } else {
+        assert_eq!(got[0], want, "{preset} seed {seed} {method}: the simulation changed (see the module docs)");
+    }
+}
+
+/// One test per pinned line (two presets × four methods), so that the harness runs them
+/// side by side.
+macro_rules! pinned {
+    ($($name:ident: $preset:literal $method:literal;)*) => {$(
+        #[test]
+        fn $name() {
+            check($preset, $method);
+        }
+    )*};
+}
+
+pinned! {
+    palm_zioma_matches_its_digest_on_1_and_3_threads: "palm" "zioma";
+    palm_akagi_matches_its_digest_on_1_and_3_threads: "palm" "akagi";
+    palm_skjermo_matches_its_digest_on_1_and_3_threads: "palm" "skjermo";
+    palm_hsm_matches_its_digest_on_1_and_3_threads: "palm" "hsm";
+    sympodial_zioma_matches_its_digest_on_1_and_3_threads: "sympodial" "zioma";
+    sympodial_akagi_matches_its_digest_on_1_and_3_threads: "sympodial" "akagi";
+    sympodial_skjermo_matches_its_digest_on_1_and_3_threads: "sympodial" "skjermo";
+    sympodial_hsm_matches_its_digest_on_1_and_3_threads: "sympodial" "hsm";
+}
+
+/// Every pinned line has its test above.
+#[test]
+fn every_pinned_line_is_checked() {
+    let lines = include_str!("simulation_digests.txt").lines().filter(|l| !l.trim().is_empty() && !l.starts_with('#'));
+    assert_eq!(lines.count(), 8, "two presets × four methods: add a test for a new line");
 }

@@ -5,8 +5,9 @@ use crate::methods::akagi::{RawAkagiSegment, RawAkagiStep};
 use crate::model::RawSegment;
 use crate::physics::DragModel;
 use crate::physics::oscillator::damped_step;
+use crate::simd::dispatch;
+use crate::wind::lanes::{LANES, V3, wind_lanes};
 use crate::wind::raw::{RawField, RawWave};
-use crate::wind::sample::wind_at;
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
@@ -15,6 +16,10 @@ use rayon::prelude::*;
 /// with the segment's own velocity `γ = ρ C_d A |u| g(|u|)` (N·s/m: a part moving with the
 /// wind at v feels `F − γ v`); `2i + 1` the centre. Bindings: 0 fields, 1 waves,
 /// 2 segments, 3 akagi segments, 4 joints, 5 acc, 6 step, 7 forces.
+///
+/// The WGSL samples the wind in each segment's invocation; here sixteen centres at a time
+/// ([`crate::wind::lanes`], whose polynomial sine agrees with `wind_at` to its error), in
+/// fixed groups, so the result does not depend on the thread count or the instruction set.
 #[allow(clippy::too_many_arguments)]
 pub fn akagi_forces(
     fields: &[RawField],
@@ -26,23 +31,54 @@ pub fn akagi_forces(
     step: RawAkagiStep,
     out: &mut [[f32; 4]],
 ) {
+    let level = crate::simd::level();
+    out.par_chunks_mut(2 * LANES).enumerate().for_each(|(k, o)| {
+        let base = k * LANES;
+        forces_group(level, fields, waves, &segments[base..], &akagi[base..], &joints[base..], &acc[base..], &step, o);
+    });
+}
+
+dispatch! {
+/// [`akagi_forces`] for one group of up to sixteen segments (`out` two entries each).
+#[allow(clippy::too_many_arguments)]
+fn forces_group(
+    fields: &[RawField],
+    waves: &[RawWave],
+    segments: &[RawSegment],
+    akagi: &[RawAkagiSegment],
+    joints: &[[f32; 4]],
+    acc: &[[f32; 4]],
+    step: &RawAkagiStep,
+    out: &mut [[f32; 4]],
+) {
+    let n = out.len() / 2;
     let drag = DragModel { reconfiguration_speed: step.reconfiguration_speed, vogel_exponent: step.vogel_exponent };
-    out.par_chunks_mut(2).enumerate().for_each(|(i, o)| {
+    let mut axis = [Vec3::ZERO; LANES];
+    let mut centre = [Vec3::ZERO; LANES];
+    for i in 0..n {
         let s = &segments[i];
-        let axis = Quat::from_array(acc[i]) * (Quat::from_array(s.orientation) * Vec3::Y);
-        let centre = Vec3::new(joints[i][0], joints[i][1], joints[i][2]) + axis * (0.5 * s.length);
-        let w = wind_at(fields, waves, centre, step.time);
+        axis[i] = Quat::from_array(acc[i]) * (Quat::from_array(s.orientation) * Vec3::Y);
+        centre[i] = Vec3::new(joints[i][0], joints[i][1], joints[i][2]) + axis[i] * (0.5 * s.length);
+    }
+    // A short last group repeats its last centre in the unused lanes.
+    for i in n..LANES {
+        centre[i] = centre[n - 1];
+    }
+    let wind = if fields.is_empty() { V3::ZERO } else { wind_lanes(fields, waves, V3::from_lanes(centre), step.time) };
+    for (i, o) in out.chunks_mut(2).enumerate() {
+        let w = wind.lane(i);
         let u = w.length();
         o[0] = if u < 1e-6 {
             [0.0; 4]
         } else {
-            let sin_phi = (w / u).cross(axis).length();
+            let sin_phi = (w / u).cross(axis[i]).length();
             let cd_area = step.drag * (akagi[i].bark_area * sin_phi + akagi[i].leaf_area);
             let f = drag.force(cd_area, w);
             [f.x, f.y, f.z, drag.damping(cd_area, u)]
         };
-        o[1] = [centre.x, centre.y, centre.z, 0.0];
-    });
+        o[1] = [centre[i].x, centre[i].y, centre[i].z, 0.0];
+    }
+}
 }
 
 /// One depth of the propagation toward the root, for the segments of `bucket` (their
