@@ -283,6 +283,44 @@ fn zioma_instances_ring_down_on_the_gpu_as_on_the_cpu() {
     assert_ne!(got[0].start, got[1].start, "the copies ring alike");
 }
 
+/// `reset` returns the GPU's copies to rest as the CPU's `reset` returns its state: in
+/// still air every copy is at rest bit for bit at once (they were ringing), and when the gusty
+/// wind then starts over from the reset time, the copies follow the CPU's within 1e-4 ×
+/// height half a second later.
+#[test]
+fn zioma_reset_on_the_gpu_forgot_its_rings() {
+    use sylva_core::methods::Method;
+    use sylva_core::methods::zioma::ZiomaInstance;
+    use sylva_core::pose::SeamPose;
+    use sylva_gpu::methods::GpuAnimator;
+    let Some(ctx) = common::gpu() else { return };
+    let instances = ZiomaInstance::grid(9, 40.0, 5);
+    let (t, z, s, mut gpu) = gusty_then_calm(ctx, &instances);
+    let at = s.time;
+    assert!(gpu.poses(ctx, at).unwrap().iter().any(|p| *p != Pose::rest(&t)), "nothing rang before the reset");
+    gpu.reset(ctx, at);
+    for (k, p) in gpu.poses(ctx, at).unwrap().iter().enumerate() {
+        assert_eq!(*p, Pose::rest(&t), "instance {k} still rings after the reset");
+    }
+    let wind = WindScene::resolve("gusty").unwrap();
+    let fw = wind.packed();
+    gpu.set_wind(&GpuWind::from_scene(ctx, &wind).unwrap());
+    gpu.reset(ctx, at);
+    let mut cpu = z.rest_state(&t);
+    z.set_time(&mut cpu, at);
+    z.set_instances(&t, &mut cpu, &instances);
+    for _ in 0..30 {
+        z.step(&t, &fw, &mut cpu, 1.0 / 60.0);
+    }
+    gpu.advance(ctx, 1.0 / 60.0, 30);
+    assert_eq!(gpu.time, cpu.time);
+    let mut seam = SeamPose::default();
+    assert!(z.seam_instances(&t, &fw, &cpu, &instances, &mut seam));
+    for (k, g) in gpu.poses(ctx, cpu.time).unwrap().iter().enumerate() {
+        compare(&t, &seam.pose(&t, k), g, &format!("instance {k}, half a second after the reset"));
+    }
+}
+
 #[test]
 fn zioma_on_the_gpu_is_at_rest_in_still_air() {
     let Some(ctx) = common::gpu() else { return };

@@ -185,7 +185,13 @@ impl GpuAnimator for GpuZioma {
         self.wind = wind.clone();
         self.rotations = None;
     }
+    /// Back to rest at `time`, as the CPU's `reset`: the wind starts blowing then, so every
+    /// instance's ring is the one of a change from still air at `time`.
     fn reset(&mut self, _ctx: &GpuContext, time: f32) {
+        let rest = vec![Ring::default(); self.instances.len()];
+        let calm = sylva_core::wind::PackedWind::calm();
+        self.rings = self.method.instance_rings_after(&calm, &self.wind.packed, &rest, &self.instances, time);
+        self.rings_changed = true;
         self.time = time;
     }
     fn advance(&mut self, ctx: &GpuContext, dt: f32, steps: usize) {
