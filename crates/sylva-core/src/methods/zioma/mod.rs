@@ -226,13 +226,19 @@ impl Zioma {
         self.trunk.ring_after((&[], &[]), (fields, waves), &Ring::default(), self.crown_centre, 0.0)
     }
 
-    /// Every instance's ring of a wind blowing since t = 0 from still air.
-    pub fn start_rings(&self, fields: &[RawField], waves: &[RawWave], instances: &[ZiomaInstance]) -> Vec<Ring> {
+    /// Every instance's ring of a wind blowing since `t` from still air.
+    pub fn start_rings(
+        &self,
+        fields: &[RawField],
+        waves: &[RawWave],
+        instances: &[ZiomaInstance],
+        t: f32,
+    ) -> Vec<Ring> {
         instances
             .par_iter()
             .map(|i| {
                 let crown = i.to_world(self.crown_centre);
-                self.trunk.ring_after((&[], &[]), (fields, waves), &Ring::default(), crown, 0.0)
+                self.trunk.ring_after((&[], &[]), (fields, waves), &Ring::default(), crown, t)
             })
             .collect()
     }
@@ -307,7 +313,14 @@ impl Zioma {
         t: f32,
         instances: &[ZiomaInstance],
     ) -> Vec<[f32; 4]> {
-        self.rotations_instances_ringing(tree, fields, waves, t, instances, &self.start_rings(fields, waves, instances))
+        self.rotations_instances_ringing(
+            tree,
+            fields,
+            waves,
+            t,
+            instances,
+            &self.start_rings(fields, waves, instances, 0.0),
+        )
     }
 
     /// [`Self::rotations_instances`], each instance ringing by its own ring in `rings`.

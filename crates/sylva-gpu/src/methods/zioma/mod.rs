@@ -72,7 +72,7 @@ impl GpuZioma {
         let count = instances.len();
         let zeroed: RawZiomaFrame = bytemuck::Zeroable::zeroed();
         let placements: Vec<RawZiomaInstance> = instances.iter().map(RawZiomaInstance::from).collect();
-        let rings = method.start_rings(&wind.packed.fields, &wind.packed.waves, &instances);
+        let rings = method.start_rings(&wind.packed.fields, &wind.packed.waves, &instances, 0.0);
         let raw_rings: Vec<RawZiomaRing> = rings.iter().map(RawZiomaRing::from).collect();
         Ok(Self {
             rings,
@@ -188,9 +188,7 @@ impl GpuAnimator for GpuZioma {
     /// Back to rest at `time`, as the CPU's `reset`: the wind starts blowing then, so every
     /// instance's ring is the one of a change from still air at `time`.
     fn reset(&mut self, _ctx: &GpuContext, time: f32) {
-        let rest = vec![Ring::default(); self.instances.len()];
-        let calm = sylva_core::wind::PackedWind::calm();
-        self.rings = self.method.instance_rings_after(&calm, &self.wind.packed, &rest, &self.instances, time);
+        self.rings = self.method.start_rings(&self.wind.packed.fields, &self.wind.packed.waves, &self.instances, time);
         self.rings_changed = true;
         self.time = time;
     }
