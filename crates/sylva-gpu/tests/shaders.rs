@@ -506,6 +506,7 @@ fn hsm_structs_match_their_wgsl_twins() {
             ("hold", offset_of!(RawHsmStep, hold)),
             ("reconfiguration_speed", offset_of!(RawHsmStep, reconfiguration_speed)),
             ("vogel_exponent", offset_of!(RawHsmStep, vogel_exponent)),
+            ("air", offset_of!(RawHsmStep, air)),
         ],
     );
 }

@@ -49,7 +49,8 @@ pub struct FidelityArgs {
     /// Simulation rate, Hz.
     #[arg(long, default_value_t = 60.0)]
     pub rate: f32,
-    /// Shorter runs (a 12 s pluck, 10 s steps, 30 s of gusts) for a first look.
+    /// Shorter runs (a 12 s pluck, 10 s steps, 20 s of gusts per neighbour; the sway still
+    /// over a minute) for a first look.
     #[arg(long)]
     pub quick: bool,
     /// Directory for the report and its plots.

@@ -431,16 +431,18 @@ fn goal_displacement(st: &RawHsmClusterState, q: Vec3A) -> Vec3A {
 /// the hold) from `u` (both
 /// displacements from rest, so `g − u` is the goal minus the position), gravity,
 /// semi-implicit drag toward `wind` with drag factor `kd` (its own times its owner's
-/// [`reconfiguration`]), damping. WGSL: `hsm_velocity`.
+/// [`reconfiguration`]) on the relative velocity `wind − a v` (`a` = `step.air`, see
+/// [`super::HsmParams::air_damping`]), damping. WGSL: `hsm_velocity`.
 #[inline(always)]
 fn particle_velocity(v: Vec3A, g: [f32; 4], u: Vec3A, wind: Vec3A, kd: f32, step: &RawHsmStep) -> Vec3A {
     let h = step.dt;
     let gravity = Vec3A::from_array([step.gravity[0], step.gravity[1], step.gravity[2]]);
     // ᾱ / h as ᾱ · (1 / h): one division per step, not per particle.
     let mut vel = v + (a3(g) - u) * (g[3].min(step.hold) * (1.0 / h)) + gravity * ((1.0 - step.gravity[3]) * h);
-    let rel = wind - vel;
+    // Implicit in the new velocity v' for the drag `kd |r| (wind − a v')`, |r| at its start.
+    let rel = wind - vel * step.air;
     let s = h * kd * rel.length();
-    vel += rel * (s / (1.0 + s));
+    vel += rel * (s / (1.0 + step.air * s));
     vel * step.damping
 }
 

@@ -298,7 +298,7 @@ impl Hsm {
             hold: self.hold(dt),
             reconfiguration_speed: p.reconfiguration_speed,
             vogel_exponent: p.vogel_exponent,
-            _pad: 0.0,
+            air: if p.drag_scale > 0.0 { p.air_damping / p.drag_scale } else { 1.0 },
         }
     }
 

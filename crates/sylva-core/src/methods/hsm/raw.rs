@@ -128,8 +128,9 @@ pub struct RawHsmStep {
     pub reconfiguration_speed: f32,
     /// [`super::HsmParams::vogel_exponent`].
     pub vogel_exponent: f32,
-    /// Padding to 16 bytes.
-    pub _pad: f32,
+    /// The drag's relative velocity is `wind − air · v`: [`super::HsmParams::air_damping`]
+    /// over [`super::HsmParams::drag_scale`] (1 when the drag scale is 0).
+    pub air: f32,
 }
 
 /// [`super::HsmState::velocity`]'s w for a fixed particle (free ones carry their drag factor ≥ 0).

@@ -295,6 +295,7 @@ pub(crate) mod avx2 {
         let damping = _mm256_set1_ps(step.damping);
         let zero = _mm256_setzero_ps();
         let one = _mm256_set1_ps(1.0);
+        let air = _mm256_set1_ps(step.air);
         let [qx, qy, qz] = &runs.q;
         for run in chunk {
             let clusters =
@@ -354,13 +355,13 @@ pub(crate) mod avx2 {
                 let mut vel: [__m256; 3] = std::array::from_fn(|a| {
                     _mm256_add_ps(_mm256_add_ps(v[a], _mm256_mul_ps(_mm256_sub_ps(goal[a], u[a]), scale)), gravity[a])
                 });
-                let rel: [__m256; 3] = std::array::from_fn(|a| _mm256_sub_ps(wind[a], vel[a]));
+                let rel: [__m256; 3] = std::array::from_fn(|a| _mm256_sub_ps(wind[a], _mm256_mul_ps(vel[a], air)));
                 let dot = _mm256_add_ps(
                     _mm256_add_ps(_mm256_mul_ps(rel[0], rel[0]), _mm256_mul_ps(rel[1], rel[1])),
                     _mm256_mul_ps(rel[2], rel[2]),
                 );
                 let s = _mm256_mul_ps(_mm256_mul_ps(hs, _mm256_mul_ps(kd, reconfigured)), _mm256_sqrt_ps(dot));
-                let f = _mm256_div_ps(s, _mm256_add_ps(one, s));
+                let f = _mm256_div_ps(s, _mm256_add_ps(one, _mm256_mul_ps(air, s)));
                 for a in 0..3 {
                     vel[a] = _mm256_mul_ps(_mm256_add_ps(vel[a], _mm256_mul_ps(rel[a], f)), damping);
                 }

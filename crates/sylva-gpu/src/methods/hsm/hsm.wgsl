@@ -66,6 +66,7 @@ struct HsmStep {
     hold: f32,
     reconfiguration_speed: f32,
     vogel_exponent: f32,
+    air: f32,
 }
 
 // Vogel's reconfiguration of a cluster's drag in the wind `u` at its centre, (1 + r²)^(B/2)
@@ -181,8 +182,8 @@ fn hsm_goal_displacement(st: HsmClusterState, q: vec3<f32>) -> vec3<f32> {
 fn hsm_velocity(v: vec3<f32>, g: vec4<f32>, u: vec3<f32>, wind: vec3<f32>, kd: f32, step: HsmStep) -> vec3<f32> {
     let h = step.dt;
     var vel = v + (g.xyz - u) * (min(g.w, step.hold) * (1.0 / h)) + step.gravity.xyz * ((1.0 - step.gravity.w) * h);
-    let rel = wind - vel;
+    let rel = wind - vel * step.air;
     let s = h * kd * length(rel);
-    vel += rel * (s / (1.0 + s));
+    vel += rel * (s / (1.0 + step.air * s));
     return vel * step.damping;
 }
