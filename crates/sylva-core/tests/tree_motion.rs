@@ -252,7 +252,8 @@ fn hsm_damping_is_in_the_field_range_and_rises_with_wind() {
 
 /// HSM's `drag_scale` (3) also tripled the air's damping, and its ζ passed 0.2 at 15 m/s on
 /// the 16 and 21 m aspens. The scale now carries the load only: the lean in a steady wind is
-/// the same with the air's damping at 1 or at the scale (±1 %), and the ring is damped less.
+/// the same with the air's damping at its default (1.5) or at the scale (±1 %), and the ring is
+/// damped less.
 #[test]
 fn hsm_drag_scale_scales_the_load_not_the_air_damping() {
     let t = small_aspen();

@@ -66,10 +66,11 @@ pub struct HsmParams {
     /// particle's drag is `kd |r| r` on the relative velocity `r = wind − (air_damping /
     /// drag_scale) v`, so the load in still parts is the scaled drag's and the drag's change
     /// with the particle's own velocity (`∂F/∂v`, the aerodynamic damping) is `air_damping`
-    /// times the unscaled drag's. Default 1: the scale stands in for the clusters' static
-    /// stiffness, not for more air, and the unscaled drag damps the trunk as Akagi's and
-    /// Skjermo's beams are damped (ζ 0.10–0.14 at 15 m/s on the aspen's sizes, against
-    /// 0.20–0.27 with the scale on the damping too). `drag_scale` gives the old behaviour.
+    /// times the unscaled drag's. Default 1.5: the scale stands in for the clusters' static
+    /// stiffness, not for more air. On the aspen's size series (7–21 m) ζ is then 0.09–0.16
+    /// at 15 m/s, rising with the wind at every size; with 3 (the scale on the damping too)
+    /// 0.17–0.27, past the field's 0.2, and with 1 at most 0.12 but no longer rising past
+    /// 10 m/s on three sizes (`sylva fidelity --quick --species quaking_aspen`).
     pub air_damping: f32,
     /// Speed around which bark and leaves streamline, m/s (see
     /// [`crate::physics::DragModel`]; default 5, as the other methods).
@@ -141,7 +142,7 @@ impl Default for HsmParams {
             drag: 0.8,
             leaf_drag: 0.05,
             drag_scale: 3.0,
-            air_damping: 1.0,
+            air_damping: 1.5,
             reconfiguration_speed: crate::physics::DragModel::default().reconfiguration_speed,
             vogel_exponent: crate::physics::DragModel::default().vogel_exponent,
             gravity: 9.81,
