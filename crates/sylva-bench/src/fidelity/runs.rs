@@ -34,7 +34,7 @@ impl Protocol {
     /// The default runs.
     pub const FULL: Self = Self { load: 3.0, ring: 25.0, step: 25.0, gusty: 70.0, neighbours: 70.0 };
     /// `--quick`. The sway is still read over a minute, as field studies and the tests read
-    /// it: 20 s of `gusty` are mostly its gust front, which read up to a quarter more.
+    /// it: 20 s of `gusty` are mostly its gust front, which read about a third more.
     pub const QUICK: Self = Self { load: 2.0, ring: 12.0, step: 10.0, gusty: 70.0, neighbours: 30.0 };
 }
 
