@@ -40,6 +40,12 @@ pub mod simd;
 pub mod species;
 pub mod wind;
 
+/// Fewest items a CPU kernel hands to rayon's pool; smaller batches run on the calling thread.
+/// A parallel call from outside the pool waits for a worker, and when the pool is shared (an
+/// application's other work, several simulations at once) it waits behind everything already
+/// queued there: a few hundred segments' worth of work is cheaper than that hand-off.
+pub const PARALLEL_FROM: usize = 4096;
+
 pub use generate::lsystem::{Grammar, GrammarError, LSystemOptions};
 pub use generate::weber_penn::{WeberPennError, WeberPennParams};
 pub use limits::{LimitExceeded, Limits};

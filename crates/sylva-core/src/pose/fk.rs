@@ -103,10 +103,15 @@ pub fn pose_forward(
     }
     // Every segment in index order is a single bucket that respects parents first.
     let order: Vec<u32> = (0..n as u32).collect();
-    acc.par_chunks_mut(n).zip(joints.par_chunks_mut(n)).zip(delta.par_chunks(n)).for_each(|((acc, joints), delta)| {
+    let one = |acc: &mut [[f32; 4]], joints: &mut [[f32; 4]], delta: &[[f32; 4]]| {
         let mut disp = vec![[0.0f32; 4]; n];
         pose_level(&order, parent, rest, delta, acc, &mut disp, joints);
-    });
+    };
+    // One instance (every CPU method's step) runs here, without a hand-off to the pool.
+    if acc.len() == n {
+        return one(acc, joints, delta);
+    }
+    acc.par_chunks_mut(n).zip(joints.par_chunks_mut(n)).zip(delta.par_chunks(n)).for_each(|((a, j), d)| one(a, j, d));
 }
 
 /// Joint positions from accumulated rotations `D` in one pass in topological order (as
@@ -117,7 +122,7 @@ pub fn positions_forward(parent: &[u32], rest: &[[f32; 4]], acc: &[[f32; 4]], jo
     if n == 0 {
         return;
     }
-    joints.par_chunks_mut(n).zip(acc.par_chunks(n)).for_each(|(joints, acc)| {
+    let one = |(joints, acc): (&mut [[f32; 4]], &[[f32; 4]])| {
         let mut disp = vec![Vec3::ZERO; n];
         for i in 0..n {
             let p = parent[i];
@@ -128,7 +133,11 @@ pub fn positions_forward(parent: &[u32], rest: &[[f32; 4]], acc: &[[f32; 4]], jo
             }
             joints[i] = (v3(rest[i]) + disp[i]).extend(0.0).to_array();
         }
-    });
+    };
+    if joints.len() == n {
+        return one((joints, acc));
+    }
+    joints.par_chunks_mut(n).zip(acc.par_chunks(n)).for_each(one);
 }
 
 fn v3(a: [f32; 4]) -> Vec3 {

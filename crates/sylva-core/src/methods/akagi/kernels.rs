@@ -102,28 +102,36 @@ pub fn akagi_subtree(
     sub: &mut [[f32; 4]],
 ) {
     let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
-    let sums: Vec<(usize, [[f32; 4]; 3])> = bucket
-        .par_iter()
-        .map(|&i| {
+    // Joint i's sums from its own drag and its children's sums (a deeper bucket's).
+    let joint = |i: usize, sub: &[[f32; 4]]| {
+        let p = v(joints[i]);
+        let (mut f, mut s0) = (v(f_own[2 * i]), f_own[2 * i][3]);
+        let r = v(f_own[2 * i + 1]) - p;
+        let (mut m, mut s1, mut gamma) = (r.cross(f), r * s0, s0 * r.length_squared());
+        let o = offset[i] as usize;
+        for &c in &index[o..o + count[i] as usize] {
+            let c = c as usize;
+            let d = v(joints[c]) - p;
+            let (fc, s0c, s1c) = (v(sub[3 * c]), sub[3 * c][3], v(sub[3 * c + 2]));
+            f += fc;
+            m += v(sub[3 * c + 1]) + d.cross(fc);
+            gamma += sub[3 * c + 1][3] + 2.0 * d.dot(s1c) + d.length_squared() * s0c;
+            s1 += s1c + d * s0c;
+            s0 += s0c;
+        }
+        [[f.x, f.y, f.z, s0], [m.x, m.y, m.z, gamma], [s1.x, s1.y, s1.z, 0.0]]
+    };
+    if bucket.len() < crate::PARALLEL_FROM {
+        // A bucket's children lie in a deeper bucket, so writing as we go reads nothing
+        // this bucket writes.
+        for &i in bucket {
             let i = i as usize;
-            let p = v(joints[i]);
-            let (mut f, mut s0) = (v(f_own[2 * i]), f_own[2 * i][3]);
-            let r = v(f_own[2 * i + 1]) - p;
-            let (mut m, mut s1, mut gamma) = (r.cross(f), r * s0, s0 * r.length_squared());
-            let o = offset[i] as usize;
-            for &c in &index[o..o + count[i] as usize] {
-                let c = c as usize;
-                let d = v(joints[c]) - p;
-                let (fc, s0c, s1c) = (v(sub[3 * c]), sub[3 * c][3], v(sub[3 * c + 2]));
-                f += fc;
-                m += v(sub[3 * c + 1]) + d.cross(fc);
-                gamma += sub[3 * c + 1][3] + 2.0 * d.dot(s1c) + d.length_squared() * s0c;
-                s1 += s1c + d * s0c;
-                s0 += s0c;
-            }
-            (i, [[f.x, f.y, f.z, s0], [m.x, m.y, m.z, gamma], [s1.x, s1.y, s1.z, 0.0]])
-        })
-        .collect();
+            let e = joint(i, sub);
+            sub[3 * i..3 * i + 3].copy_from_slice(&e);
+        }
+        return;
+    }
+    let sums: Vec<(usize, [[f32; 4]; 3])> = bucket.par_iter().map(|&i| (i as usize, joint(i as usize, sub))).collect();
     for (i, e) in sums {
         sub[3 * i..3 * i + 3].copy_from_slice(&e);
     }

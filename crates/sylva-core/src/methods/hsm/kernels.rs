@@ -9,7 +9,7 @@ use crate::methods::hsm::{
 };
 use crate::model::NONE;
 use crate::simd::dispatch;
-use crate::wind::lanes::{LANES as WIND_LANES, V3, wind_lanes};
+use crate::wind::lanes::{LANES as WIND_LANES, V, V3, wind_lanes};
 use crate::wind::raw::{RawField, RawWave};
 use glam::{Mat3, Quat, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
@@ -50,22 +50,12 @@ fn v3(a: [f32; 4]) -> Vec3 {
 /// runs started 1e-10 m/s apart ended 1e-5 × the tree's height apart after 1,000 steps,
 /// however small the start's difference (and a GPU, rounding differently, 5e-3).
 pub fn extract_rotation(a: Mat3, q: Quat, iterations: u32) -> Quat {
-    extract_rotations([a], [q], iterations)[0]
-}
-
-/// [`extract_rotation`] of `N` matrices, their iterations in lockstep: the same operations
-/// for each, so the same bits, but `N` independent chains of dependent operations (a
-/// division and a square root each iteration) for the CPU to overlap.
-#[inline(always)]
-pub fn extract_rotations<const N: usize>(a: [Mat3; N], q: [Quat; N], iterations: u32) -> [Quat; N] {
     let mut q = q;
-    let eps = a.map(|a| 1e-6 * (a.x_axis.length() + a.y_axis.length() + a.z_axis.length()) + 1e-30);
+    let eps = 1e-6 * (a.x_axis.length() + a.y_axis.length() + a.z_axis.length()) + 1e-30;
     for _ in 0..iterations {
-        for k in 0..N {
-            let r = Mat3::from_quat(q[k]);
-            let half = rotation_step(r, a[k], eps[k]) * 0.5;
-            q[k] = (Quat::from_xyzw(half.x, half.y, half.z, 1.0) * q[k]).normalize();
-        }
+        let r = Mat3::from_quat(q);
+        let half = rotation_step(r, a, eps) * 0.5;
+        q = (Quat::from_xyzw(half.x, half.y, half.z, 1.0) * q).normalize();
     }
     q
 }
@@ -228,7 +218,7 @@ pub(crate) fn hsm_clusters_with<S>(
     state.par_chunks_mut(CHUNK).enumerate().for_each(|(k, chunk)| {
         let base = k * CHUNK;
         let mut quarter = [[Vec3A::ZERO; 4]; LANES / 4];
-        // Four clusters at a time, their rotations extracted in lockstep.
+        // Sixteen clusters at a time, their rotations extracted in SIMD lanes.
         for (g, group) in chunk.chunks_mut(ROTATIONS).enumerate() {
             let at = base + g * ROTATIONS;
             let mut apq = [(Mat3::ZERO, Vec3::ZERO); ROTATIONS];
@@ -239,9 +229,9 @@ pub(crate) fn hsm_clusters_with<S>(
                 apq[i] = cluster_apq(&clusters[at + i], sums(at + i, sp, &mut quarter), sp);
             }
             // A last, short group is padded with zero matrices (their rotations are unused).
-            let start =
+            let mut q: [Quat; ROTATIONS] =
                 std::array::from_fn(|i| group.get(i).map_or(Quat::IDENTITY, |st| Quat::from_array(st.rotation)));
-            let q = extract_rotations(apq.map(|s| s.0), start, step.polar_iterations);
+            extract_rotations_at(level, &apq.map(|s| s.0), &mut q, step.polar_iterations);
             for (i, st) in group.iter_mut().enumerate() {
                 finish_cluster(&clusters[at + i], apq[i], q[i], &step, st);
             }
@@ -252,8 +242,96 @@ pub(crate) fn hsm_clusters_with<S>(
     });
 }
 
-/// Clusters whose rotations stage 1 extracts together (see [`extract_rotations`]).
-const ROTATIONS: usize = 4;
+/// Clusters whose rotations stage 1 extracts together (see [`extract_rotations_at`]).
+const ROTATIONS: usize = WIND_LANES;
+
+dispatch! {
+/// [`extract_rotation`] of sixteen matrices at once, one per [`crate::simd::F32x16`] lane
+/// (the CPU's vector unit, AVX2 where it has it): every lane takes the same IEEE operations in
+/// the same order as the scalar path (glam's `Vec3` and `Mat3` arithmetic, its SSE2 `Quat`
+/// product and normalisation), so the same bits (tested). The branches of [`rotation_step`]
+/// become selects.
+pub(crate) fn extract_rotations_at(a: &[Mat3; ROTATIONS], q: &mut [Quat; ROTATIONS], iterations: u32) {
+    let col = |c: usize| V3::from_lanes(std::array::from_fn(|l| a[l].col(c)));
+    let a = [col(0), col(1), col(2)];
+    let comp = |k: usize| V::from(std::array::from_fn(|l| q[l].to_array()[k]));
+    let out = extract_rotation_lanes(a, [comp(0), comp(1), comp(2), comp(3)], iterations);
+    for (l, q) in q.iter_mut().enumerate() {
+        *q = Quat::from_array(out.map(|c| c.as_array_ref()[l]));
+    }
+}
+}
+
+/// [`extract_rotations`] on lanes: `a` by columns, `q` as x, y, z, w.
+#[inline(always)]
+fn extract_rotation_lanes(a: [V3; 3], q: [V; 4], iterations: u32) -> [V; 4] {
+    let eps = V::splat(1e-6) * (a[0].length() + a[1].length() + a[2].length()) + V::splat(1e-30);
+    let [mut x, mut y, mut z, mut w] = q;
+    for _ in 0..iterations {
+        // Mat3::from_quat.
+        let (x2, y2, z2) = (x + x, y + y, z + z);
+        let (xx, xy, xz) = (x * x2, x * y2, x * z2);
+        let (yy, yz, zz) = (y * y2, y * z2, z * z2);
+        let (wx, wy, wz) = (w * x2, w * y2, w * z2);
+        let one = V::ONE;
+        let r = [
+            V3 { x: one - (yy + zz), y: xy + wz, z: xz - wy },
+            V3 { x: xy - wz, y: one - (xx + zz), z: yz + wx },
+            V3 { x: xz + wy, y: yz - wx, z: one - (xx + yy) },
+        ];
+        let s = rotation_step_lanes(r, a, eps);
+        let (hx, hy, hz) = (s.x * 0.5, s.y * 0.5, s.z * 0.5);
+        // (h, 1) · q as glam's SSE2 product adds it: (w₀q + x₀·wzyx·±) + (y₀·zwxy·± + z₀·yxwz·±),
+        // w₀ = 1.
+        let px = (x + hx * w) + (hy * z - hz * y);
+        let py = (y - hx * z) + (hy * w + hz * x);
+        let pz = (z + hx * y) + (hz * w - hy * x);
+        let pw = (w - hx * x) + (-(hy * y) - hz * z);
+        // Vec4::normalize: divided by √((x² + z²) + (y² + w²)).
+        let len = ((px * px + pz * pz) + (py * py + pw * pw)).sqrt();
+        (x, y, z, w) = (px / len, py / len, pz / len, pw / len);
+    }
+    [x, y, z, w]
+}
+
+/// [`rotation_step`] on lanes, its two early returns as selects.
+#[inline(always)]
+fn rotation_step_lanes(r: [V3; 3], a: [V3; 3], eps: V) -> V3 {
+    let g = r[0].cross(a[0]) + r[1].cross(a[1]) + r[2].cross(a[2]);
+    let tr = r[0].dot(a[0]) + r[1].dot(a[1]) + r[2].dot(a[2]);
+    let d = tr.abs() + eps;
+    let muller = V3 { x: g.x / d, y: g.y / d, z: g.z / d };
+    let near = NEWTON_NEAR * NEWTON_NEAR;
+    let s_near = ((V::splat(4.0 * near) - muller.dot(muller)) / V::splat(3.0 * near)).min(V::ONE);
+    let zero = V::ZERO;
+    // Columns of B = A Rᵀ: bₖ = Σᵢ aᵢ rᵢ[k].
+    let b0 = a[0].scale(r[0].x) + a[1].scale(r[1].x) + a[2].scale(r[2].x);
+    let b1 = a[0].scale(r[0].y) + a[1].scale(r[1].y) + a[2].scale(r[2].y);
+    let b2 = a[0].scale(r[0].z) + a[1].scale(r[1].z) + a[2].scale(r[2].z);
+    let h00 = tr - b0.x;
+    let h11 = tr - b1.y;
+    let h22 = tr - b2.z;
+    let h01 = V::splat(-0.5) * (b1.x + b0.y);
+    let h02 = V::splat(-0.5) * (b2.x + b0.z);
+    let h12 = V::splat(-0.5) * (b2.y + b1.z);
+    let c00 = h11 * h22 - h12 * h12;
+    let c01 = h02 * h12 - h01 * h22;
+    let c02 = h01 * h12 - h02 * h11;
+    let c11 = h00 * h22 - h02 * h02;
+    let c12 = h01 * h02 - h00 * h12;
+    let c22 = h00 * h11 - h01 * h01;
+    let det = h00 * c00 + h01 * c01 + h02 * c02;
+    let thin = V::splat(1e-4) * (tr * tr * tr);
+    let newton_ok = tr.cmp_gt(zero) & s_near.cmp_gt(zero) & h00.cmp_gt(zero) & c22.cmp_gt(zero) & det.cmp_gt(thin);
+    let s_pd = thin.cmp_gt(zero).blend((det / thin - V::ONE).min(V::ONE), V::ONE);
+    let newton = V3 {
+        x: (c00 * g.x + c01 * g.y + c02 * g.z) / det,
+        y: (c01 * g.x + c11 * g.y + c12 * g.z) / det,
+        z: (c02 * g.x + c12 * g.y + c22 * g.z) / det,
+    };
+    let blended = muller + (newton - muller).scale(s_near * s_pd);
+    V3::select(newton_ok, blended, muller)
+}
 
 /// Stage 1 for one cluster (one workgroup of `hsm_clusters.wgsl`) up to R: its Apq and the
 /// shift of its centre from rest, from its sums about the last shift `sp`.
@@ -597,6 +675,64 @@ mod tests {
                 bits(workgroup_sums(&run, &displacement, sp)),
                 "{count} slots"
             );
+        }
+    }
+
+    /// Stage 1's rotations on lanes ([`extract_rotations_at`], at every level the CPU has) are
+    /// [`extract_rotation`]'s bit for bit: random matrices (rotations times stretches, shears,
+    /// reflections), warm starts near and far, and the degenerate cases the steps guard
+    /// (zero, rank one, inverted, vanishing, huge, non-finite).
+    #[test]
+    fn rotations_on_lanes_are_the_scalar_rotations() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
+        let unit = |rng: &mut rand_chacha::ChaCha8Rng| {
+            Quat::from_xyzw(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            )
+            .normalize()
+        };
+        let levels: Vec<Level> = [Level::Baseline, Level::Avx2].into_iter().filter(|&l| l <= detected()).collect();
+        if levels.len() == 1 {
+            println!("this CPU has no AVX2: only the baseline level is checked");
+        }
+        for round in 0..400 {
+            let a: [Mat3; ROTATIONS] = std::array::from_fn(|l| {
+                let r = Mat3::from_quat(unit(&mut rng));
+                let s = Mat3::from_cols_array(&std::array::from_fn(|_| rng.random_range(-1.0f32..1.0)));
+                let stretch = Mat3::from_diagonal(Vec3::new(
+                    rng.random_range(0.0..2.0),
+                    rng.random_range(0.0..2.0),
+                    rng.random_range(-0.2..2.0),
+                ));
+                let m = match (round + l) % 9 {
+                    0 => Mat3::ZERO,
+                    1 => Mat3::from_cols(Vec3::X, Vec3::X * 2.0, Vec3::X * -0.5),
+                    2 => -r,
+                    3 => r * 1e-20,
+                    4 => r * 1e18,
+                    5 if round % 2 == 0 => Mat3::from_cols(Vec3::NAN, Vec3::Y, Vec3::Z),
+                    5 => Mat3::from_cols(Vec3::INFINITY, Vec3::Y, Vec3::Z),
+                    6 => r * s,
+                    _ => r * stretch + s * 0.05,
+                };
+                m * 10f32.powi(rng.random_range(-4..4))
+            });
+            let start: [Quat; ROTATIONS] =
+                std::array::from_fn(|l| if l % 3 == 0 { Quat::IDENTITY } else { unit(&mut rng) });
+            let iterations = 1 + round as u32 % 4;
+            let want = std::array::from_fn::<_, ROTATIONS, _>(|l| extract_rotation(a[l], start[l], iterations));
+            for &level in &levels {
+                let mut got = start;
+                extract_rotations_at(level, &a, &mut got, iterations);
+                for l in 0..ROTATIONS {
+                    let same = got[l].to_array().map(f32::to_bits) == want[l].to_array().map(f32::to_bits)
+                        || (got[l].is_nan() && want[l].is_nan());
+                    assert!(same, "{level:?}, {iterations} iterations, {}: {} vs {}", a[l], got[l], want[l]);
+                }
+            }
         }
     }
 

@@ -113,7 +113,7 @@ pub struct HsmParams {
     /// rate `s r²` (1/s²) whatever the substep, `ᾱ = min(Σ w, s (r h)²)`. The wood of short,
     /// thick segments is stiffer than any affordable explicit step can hold; with the hold
     /// a rate of the tree, not of the step, the same tree sways at the same frequency at 30,
-    /// 60, 120 or 240 frames/s. Default 240 (four substeps at 60 frames/s). 0: exactly
+    /// 60, 120 or 240 frames/s. Default 480 (eight substeps at 60 frames/s). 0: exactly
     /// `substeps` substeps with Müller's clamp `ᾱ ≤ 1` (Song's tables), so the stiffness
     /// then follows the step.
     pub substep_rate: f32,
