@@ -507,6 +507,8 @@ fn hsm_structs_match_their_wgsl_twins() {
             ("reconfiguration_speed", offset_of!(RawHsmStep, reconfiguration_speed)),
             ("vogel_exponent", offset_of!(RawHsmStep, vogel_exponent)),
             ("air", offset_of!(RawHsmStep, air)),
+            ("sample_wind", offset_of!(RawHsmStep, sample_wind)),
+            ("_pad", offset_of!(RawHsmStep, _pad)),
         ],
     );
 }

@@ -98,7 +98,7 @@ impl RawHsmClusterState {
     }
 }
 
-/// Per-substep values and tree information, 64 bytes. WGSL: `HsmStep`.
+/// Per-substep values and tree information, 80 bytes. WGSL: `HsmStep`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawHsmStep {
@@ -131,6 +131,10 @@ pub struct RawHsmStep {
     /// The drag's relative velocity is `wind − air · v`: [`super::HsmParams::air_damping`]
     /// over [`super::HsmParams::drag_scale`] (1 when the drag scale is 0).
     pub air: f32,
+    /// 1: stage 1 samples the wind at the segment clusters' centres (the first substep of
+    /// a step); 0: the clusters keep the wind they hold (see [`super::Hsm::step_packed`]).
+    pub sample_wind: u32,
+    pub _pad: [u32; 3],
 }
 
 /// [`super::HsmState::velocity`]'s w for a fixed particle (free ones carry their drag factor ≥ 0).

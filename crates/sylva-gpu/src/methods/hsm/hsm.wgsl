@@ -67,6 +67,8 @@ struct HsmStep {
     reconfiguration_speed: f32,
     vogel_exponent: f32,
     air: f32,
+    sample_wind: u32,
+    _pad: array<u32, 3>,
 }
 
 // Vogel's reconfiguration of a cluster's drag in the wind `u` at its centre, (1 + r²)^(B/2)

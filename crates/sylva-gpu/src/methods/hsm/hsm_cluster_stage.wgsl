@@ -100,10 +100,6 @@ fn hsm_finish_cluster(c: u32, sp: vec3<f32>, sums: HsmSums) {
     // The cluster's weight k h², past 1 only up to its path's k̂ h² (see MAX_WEIGHT).
     let bound = max(cl.aqq_inv[0].w * step.dt * step.dt, step.hold);
     let weight = min(min(cl.rest_cm.w * step.dt * step.dt, bound), MAX_WEIGHT);
-    var u = vec3<f32>(0.0);
-    if (inf.kind != HSM_LEAF) {
-        u = wind_at(cm, step.time);
-    }
     state[c].cm = vec4<f32>(cm, weight);
     state[c].rotation = q;
     state[c].transform = array<vec4<f32>, 3>(
@@ -111,5 +107,12 @@ fn hsm_finish_cluster(c: u32, sp: vec3<f32>, sums: HsmSums) {
         vec4<f32>(tr[1], shift.y),
         vec4<f32>(tr[2], shift.z),
     );
-    state[c].wind = vec4<f32>(u, hsm_reconfiguration(u, step));
+    // The wind is sampled on a step's first substep and held through the others.
+    if (step.sample_wind != 0u) {
+        var u = vec3<f32>(0.0);
+        if (inf.kind != HSM_LEAF) {
+            u = wind_at(cm, step.time);
+        }
+        state[c].wind = vec4<f32>(u, hsm_reconfiguration(u, step));
+    }
 }

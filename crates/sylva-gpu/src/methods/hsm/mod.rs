@@ -173,10 +173,11 @@ impl GpuHsm {
         while done < total {
             let batch = (total - done).min(MAX_SUBSTEPS_PER_SUBMISSION);
             // Times accumulate substep by substep as on the CPU (`state.time + h`).
-            let params: Vec<RawHsmStep> = (0..batch)
-                .map(|_| {
+            // The wind sampled on each step's first substep only, as `Hsm::step_packed`.
+            let params: Vec<RawHsmStep> = (done..done + batch)
+                .map(|k| {
                     self.time += h;
-                    method.step_params(self.time, h)
+                    RawHsmStep { sample_wind: (k % n == 0) as u32, ..method.step_params(self.time, h) }
                 })
                 .collect();
             if batch > self.steps_capacity {
