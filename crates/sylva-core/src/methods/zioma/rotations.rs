@@ -17,6 +17,16 @@ pub fn axis_or(v: Vec3, fallback: Vec3) -> Vec3 {
     if l > 1e-6 { v / l } else { fallback }
 }
 
+/// The wind at a stem's base (where every segment of the stem samples it), turned into the
+/// tree's frame (`f`'s heading).
+pub fn stem_wind(fields: &[RawField], waves: &[RawWave], stem: &RawZiomaStem, f: &RawZiomaFrame) -> Vec3 {
+    let b = Vec3::from_array(stem.base);
+    let (hc, hs) = (f.heading[0], f.heading[1]);
+    let world = Vec3::from_array(f.origin) + Vec3::new(hc * b.x + hs * b.z, b.y, -hs * b.x + hc * b.z);
+    let vw = wind_at(fields, waves, world, f.time);
+    Vec3::new(hc * vw.x - hs * vw.z, vw.y, hs * vw.x + hc * vw.z)
+}
+
 /// Rotation of segment `s`.
 pub fn zioma_rotation(
     fields: &[RawField],
@@ -25,6 +35,14 @@ pub fn zioma_rotation(
     stem: &RawZiomaStem,
     f: &RawZiomaFrame,
 ) -> Quat {
+    let wind = if s.level == 0 || f.lod == 0 { Vec3::ZERO } else { stem_wind(fields, waves, stem, f) };
+    rotation_in(s, stem, f, wind)
+}
+
+/// [`zioma_rotation`] with its stem's wind `v` ([`stem_wind`]; unread for the trunk and at
+/// LOD 0).
+#[inline]
+fn rotation_in(s: &RawSegment, stem: &RawZiomaStem, f: &RawZiomaFrame, v: Vec3) -> Quat {
     let frac = s.length / stem.length;
     let up = Vec3::Y;
     if s.level == 0 {
@@ -38,12 +56,6 @@ pub fn zioma_rotation(
     if f.lod == 0 {
         return Quat::IDENTITY;
     }
-    // The wind at the stem's base in the world, turned into the tree's frame.
-    let b = Vec3::from_array(stem.base);
-    let (hc, hs) = (f.heading[0], f.heading[1]);
-    let world = Vec3::from_array(f.origin) + Vec3::new(hc * b.x + hs * b.z, b.y, -hs * b.x + hc * b.z);
-    let vw = wind_at(fields, waves, world, f.time);
-    let v = Vec3::new(hc * vw.x - hs * vw.z, vw.y, hs * vw.x + hc * vw.z);
     let vh = Vec3::new(v.x, 0.0, v.z);
     let u = vh.length();
     if u < 1e-6 {
@@ -80,7 +92,8 @@ pub fn zioma_rotation(
         * Quat::from_axis_angle(dir, twist * frac)
 }
 
-/// The kernel's CPU twin.
+/// The kernel's CPU twin: each stem's wind sampled once per instance (the WGSL samples it in
+/// every segment's invocation; the same numbers).
 pub fn zioma_rotations(
     fields: &[RawField],
     waves: &[RawWave],
@@ -89,9 +102,19 @@ pub fn zioma_rotations(
     frames: &[RawZiomaFrame],
     out: &mut [[f32; 4]],
 ) {
-    let n = segments.len();
+    let (n, m) = (segments.len(), stems.len());
+    let winds: Vec<Vec3> = (0..frames.len() * m)
+        .into_par_iter()
+        .with_min_len(64)
+        .map(|j| {
+            let f = &frames[j / m];
+            // An instance at LOD 0 reads no stem wind.
+            if f.lod == 0 { Vec3::ZERO } else { stem_wind(fields, waves, &stems[j % m], f) }
+        })
+        .collect();
     out.par_iter_mut().enumerate().with_min_len(64).for_each(|(i, o)| {
         let s = &segments[i % n];
-        *o = zioma_rotation(fields, waves, s, &stems[s.stem as usize], &frames[i / n]).to_array();
+        let k = s.stem as usize;
+        *o = rotation_in(s, &stems[k], &frames[i / n], winds[(i / n) * m + k]).to_array();
     });
 }
