@@ -4,9 +4,10 @@
 
 use crate::methods::zioma::{RawZiomaFrame, RawZiomaStem};
 use crate::model::RawSegment;
+use crate::simd::dispatch;
+use crate::wind::lanes::{LANES, V3, wind_lanes};
 use crate::wind::noise::value_noise;
 use crate::wind::raw::{RawField, RawWave};
-use crate::wind::sample::wind_at;
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
@@ -17,32 +18,30 @@ pub fn axis_or(v: Vec3, fallback: Vec3) -> Vec3 {
     if l > 1e-6 { v / l } else { fallback }
 }
 
-/// The wind at a stem's base (where every segment of the stem samples it), turned into the
-/// tree's frame (`f`'s heading).
-pub fn stem_wind(fields: &[RawField], waves: &[RawWave], stem: &RawZiomaStem, f: &RawZiomaFrame) -> Vec3 {
-    let b = Vec3::from_array(stem.base);
+dispatch! {
+/// The wind at the bases of `stems` (where every segment of a stem samples it) for instance
+/// `f`, turned into the tree's frame: sixteen stems at a time ([`crate::wind::lanes`]).
+fn stem_winds_at(fields: &[RawField], waves: &[RawWave], stems: &[RawZiomaStem], f: &RawZiomaFrame, out: &mut [Vec3]) {
     let (hc, hs) = (f.heading[0], f.heading[1]);
-    let world = Vec3::from_array(f.origin) + Vec3::new(hc * b.x + hs * b.z, b.y, -hs * b.x + hc * b.z);
-    let vw = wind_at(fields, waves, world, f.time);
-    Vec3::new(hc * vw.x - hs * vw.z, vw.y, hs * vw.x + hc * vw.z)
+    let origin = Vec3::from_array(f.origin);
+    for (group, winds) in stems.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        let world = |l: usize| {
+            let b = Vec3::from_array(group[l.min(group.len() - 1)].base);
+            origin + Vec3::new(hc * b.x + hs * b.z, b.y, -hs * b.x + hc * b.z)
+        };
+        let u = wind_lanes(fields, waves, V3::from_lanes(std::array::from_fn(world)), f.time);
+        for (l, w) in winds.iter_mut().enumerate() {
+            let vw = u.lane(l);
+            *w = Vec3::new(hc * vw.x - hs * vw.z, vw.y, hs * vw.x + hc * vw.z);
+        }
+    }
+}
 }
 
-/// Rotation of segment `s`.
-pub fn zioma_rotation(
-    fields: &[RawField],
-    waves: &[RawWave],
-    s: &RawSegment,
-    stem: &RawZiomaStem,
-    f: &RawZiomaFrame,
-) -> Quat {
-    let wind = if s.level == 0 || f.lod == 0 { Vec3::ZERO } else { stem_wind(fields, waves, stem, f) };
-    rotation_in(s, stem, f, wind)
-}
-
-/// [`zioma_rotation`] with its stem's wind `v` ([`stem_wind`]; unread for the trunk and at
-/// LOD 0).
+/// Rotation of segment `s` in its stem's wind `v` (in the tree's frame; unread for the trunk
+/// and at LOD 0).
 #[inline]
-fn rotation_in(s: &RawSegment, stem: &RawZiomaStem, f: &RawZiomaFrame, v: Vec3) -> Quat {
+pub fn zioma_rotation(s: &RawSegment, stem: &RawZiomaStem, f: &RawZiomaFrame, v: Vec3) -> Quat {
     let frac = s.length / stem.length;
     let up = Vec3::Y;
     if s.level == 0 {
@@ -92,8 +91,8 @@ fn rotation_in(s: &RawSegment, stem: &RawZiomaStem, f: &RawZiomaFrame, v: Vec3) 
         * Quat::from_axis_angle(dir, twist * frac)
 }
 
-/// The kernel's CPU twin: each stem's wind sampled once per instance (the WGSL samples it in
-/// every segment's invocation; the same numbers).
+/// The kernel's CPU twin: each stem's wind sampled once per instance, sixteen stems at a time
+/// (the WGSL samples it in every segment's invocation; the same wind to the sine's error).
 pub fn zioma_rotations(
     fields: &[RawField],
     waves: &[RawWave],
@@ -103,18 +102,21 @@ pub fn zioma_rotations(
     out: &mut [[f32; 4]],
 ) {
     let (n, m) = (segments.len(), stems.len());
-    let winds: Vec<Vec3> = (0..frames.len() * m)
-        .into_par_iter()
-        .with_min_len(64)
-        .map(|j| {
-            let f = &frames[j / m];
-            // An instance at LOD 0 reads no stem wind.
-            if f.lod == 0 { Vec3::ZERO } else { stem_wind(fields, waves, &stems[j % m], f) }
-        })
-        .collect();
+    let level = crate::simd::level();
+    // Fixed groups of stems, so the lanes (and the bits) do not depend on the threads.
+    const GROUP: usize = 256;
+    let mut winds = vec![Vec3::ZERO; frames.len() * m];
+    winds.par_chunks_mut(m.max(1)).zip(frames).for_each(|(w, f)| {
+        // An instance at LOD 0 reads no stem wind.
+        if f.lod != 0 {
+            w.par_chunks_mut(GROUP).zip(stems.par_chunks(GROUP)).for_each(|(w, st)| {
+                stem_winds_at(level, fields, waves, st, f, w);
+            });
+        }
+    });
     out.par_iter_mut().enumerate().with_min_len(64).for_each(|(i, o)| {
         let s = &segments[i % n];
         let k = s.stem as usize;
-        *o = rotation_in(s, &stems[k], &frames[i / n], winds[(i / n) * m + k]).to_array();
+        *o = zioma_rotation(s, &stems[k], &frames[i / n], winds[(i / n) * m + k]).to_array();
     });
 }
