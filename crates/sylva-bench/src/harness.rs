@@ -43,8 +43,18 @@ pub struct Machine {
     pub gpu: Option<String>,
     /// Measured CPU copy bandwidth (read + write), bytes/s.
     pub cpu_bandwidth: f64,
-    /// Measured GPU buffer-copy bandwidth (read + write), bytes/s.
+    /// Measured GPU copy bandwidth (read + write), bytes/s: the faster of a buffer-to-buffer
+    /// copy and a copy kernel ([`gpu_bandwidth`], [`gpu_probes`]).
     pub gpu_bandwidth: Option<f64>,
+    /// The buffer-to-buffer copy's bandwidth alone, bytes/s.
+    pub gpu_buffer_copy: Option<f64>,
+    /// The copy kernel's bandwidth alone, bytes/s (with timestamp queries).
+    pub gpu_kernel_copy: Option<f64>,
+    /// GPU time of one dependent dispatch of a single workgroup, s (with timestamp queries):
+    /// the floor each dispatch of a step pays.
+    pub gpu_dispatch: Option<f64>,
+    /// GPU time of that dispatch in a compute pass of its own, s.
+    pub gpu_pass: Option<f64>,
     /// How GPU work is timed: `timestamp queries` or `wall clock`.
     pub gpu_clock: Option<&'static str>,
     /// UTC time of the run.
@@ -206,8 +216,12 @@ pub fn cpu_bandwidth() -> f64 {
     2.0 * (n * 4) as f64 / best.max(1e-9)
 }
 
-/// Buffer-to-buffer copy of 64 MiB on the GPU (best of 5): bytes read plus written per second.
+/// Buffer-to-buffer copies on the GPU, eight of 64 MiB back and forth in one submission
+/// (best of 5): bytes read plus written per second. Timed by timestamp queries around the
+/// copies where the device has them (a fast card copies 64 MiB in tens of microseconds, about
+/// what a submission and its wait cost), by wall clock from submission to completion if not.
 pub fn gpu_bandwidth(ctx: &sylva_gpu::GpuContext) -> Result<f64> {
+    const COPIES: u64 = 8;
     let bytes = 64u64 << 20;
     let make = |label| {
         ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -218,17 +232,131 @@ pub fn gpu_bandwidth(ctx: &sylva_gpu::GpuContext) -> Result<f64> {
         })
     };
     let (a, b) = (make("bandwidth a"), make("bandwidth b"));
+    let timer = sylva_gpu::timer::GpuTimer::new(ctx);
     let mut best = f64::INFINITY;
     for _ in 0..6 {
         let mut e = ctx.device.create_command_encoder(&Default::default());
-        e.copy_buffer_to_buffer(&a, 0, &b, 0, bytes);
+        if let Some(t) = &timer {
+            t.begin(&mut e);
+        }
+        for i in 0..COPIES {
+            let (from, to) = if i % 2 == 0 { (&a, &b) } else { (&b, &a) };
+            e.copy_buffer_to_buffer(from, 0, to, 0, bytes);
+        }
+        if let Some(t) = &timer {
+            t.end(&mut e);
+        }
         ctx.wait()?;
         let t0 = Instant::now();
         ctx.submit([e.finish()]);
         ctx.wait()?;
-        best = best.min(t0.elapsed().as_secs_f64());
+        let wall = t0.elapsed().as_secs_f64();
+        let stamped = match &timer {
+            Some(t) => t.read(ctx)?.map(|d| d.as_secs_f64()),
+            None => None,
+        };
+        best = best.min(stamped.unwrap_or(wall));
     }
-    Ok(2.0 * bytes as f64 / best.max(1e-9))
+    Ok(2.0 * (COPIES * bytes) as f64 / best.max(1e-9))
+}
+
+/// The machine probes of `probe.wgsl` ([`GpuProbes`]), timed by timestamp queries. `None`
+/// without timestamp queries: wall clock would time the submission, not the card.
+pub fn gpu_probes(ctx: &sylva_gpu::GpuContext) -> Result<Option<GpuProbes>> {
+    const DISPATCHES: u32 = 1000;
+    let Some(timer) = sylva_gpu::timer::GpuTimer::new(ctx) else { return Ok(None) };
+    let device = &ctx.device;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("bench probes"),
+        source: wgpu::ShaderSource::Wgsl(include_str!("probe.wgsl").into()),
+    });
+    let pipeline = |entry| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: None,
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    };
+    let bytes = 64u64 << 20;
+    let buffer = |label| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        })
+    };
+    let (src, dst) = (buffer("probe src"), buffer("probe dst"));
+    let (copy, touch) = (pipeline("copy"), pipeline("touch"));
+    let bind = |p: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)]| {
+        let entries: Vec<_> = entries
+            .iter()
+            .map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
+            .collect();
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("probe"),
+            layout: &p.get_bind_group_layout(0),
+            entries: &entries,
+        })
+    };
+    let (copy_group, touch_group) = (bind(&copy, &[(0, &src), (1, &dst)]), bind(&touch, &[(1, &dst)]));
+    let groups = (bytes / 16).div_ceil(256) as u32;
+    let (gx, gy) = (groups.min(32_768), groups.div_ceil(32_768));
+    let time = |record: &dyn Fn(&mut wgpu::CommandEncoder)| -> Result<f64> {
+        let mut best = f64::INFINITY;
+        for _ in 0..6 {
+            let mut e = device.create_command_encoder(&Default::default());
+            record(&mut e);
+            ctx.wait()?;
+            timer.start(ctx);
+            ctx.submit([e.finish()]);
+            timer.stop(ctx);
+            if let Some(d) = timer.read(ctx)? {
+                best = best.min(d.as_secs_f64());
+            }
+        }
+        Ok(best)
+    };
+    let touches = |pass: &mut wgpu::ComputePass<'_>, n: u32| {
+        pass.set_pipeline(&touch);
+        pass.set_bind_group(0, &touch_group, &[]);
+        for _ in 0..n {
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+    };
+    let copy_s = time(&|e| {
+        let mut pass = e.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&copy);
+        pass.set_bind_group(0, &copy_group, &[]);
+        pass.dispatch_workgroups(gx, gy, 1);
+    })?;
+    let touch_s = time(&|e| touches(&mut e.begin_compute_pass(&Default::default()), DISPATCHES))?;
+    let pass_s = time(&|e| {
+        for _ in 0..DISPATCHES {
+            touches(&mut e.begin_compute_pass(&Default::default()), 1);
+        }
+    })?;
+    if !(copy_s.is_finite() && touch_s.is_finite() && pass_s.is_finite()) {
+        return Ok(None);
+    }
+    let n = DISPATCHES as f64;
+    Ok(Some(GpuProbes { kernel_copy: 2.0 * bytes as f64 / copy_s.max(1e-9), dispatch: touch_s / n, pass: pass_s / n }))
+}
+
+/// What [`gpu_probes`] measures.
+#[derive(Debug, Clone, Copy)]
+pub struct GpuProbes {
+    /// A copy kernel's read + write bandwidth over 64 MiB, bytes/s (best of 5).
+    pub kernel_copy: f64,
+    /// GPU time of one dependent dispatch of a single workgroup, a thousand in one pass with
+    /// a barrier between each, s (best of 5).
+    pub dispatch: f64,
+    /// The same dispatch in a compute pass of its own, a thousand passes, s (best of 5): what
+    /// each pass adds, beside [`Self::dispatch`].
+    pub pass: f64,
 }
 
 pub fn rate_cell(r: Option<Rate>) -> String {
@@ -243,6 +371,23 @@ pub fn frac_cell(f: Option<f64>) -> String {
     f.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f))
 }
 
+/// The GPU's measured figures in words: copy bandwidth (and its two measurements, when
+/// the copy kernel was timed) and the dependent-dispatch floor.
+pub fn gpu_figures(m: &Machine) -> String {
+    let gb = |b: f64| format!("{:.1} GB/s", b / 1e9);
+    let mut s = format!("copy bandwidth {}", m.gpu_bandwidth.map_or("–".into(), gb));
+    if let (Some(b), Some(k)) = (m.gpu_buffer_copy, m.gpu_kernel_copy) {
+        s += &format!(" (buffer copy {}, copy kernel {})", gb(b), gb(k));
+    }
+    if let Some(d) = m.gpu_dispatch {
+        s += &format!(", dependent dispatch {:.1} µs", d * 1e6);
+    }
+    if let Some(p) = m.gpu_pass {
+        s += &format!(" ({:.1} µs in a pass of its own)", p * 1e6);
+    }
+    s
+}
+
 /// The heading and machine paragraph every table's Markdown starts with.
 pub fn markdown_head(title: &str, table: &str, m: &Machine) -> String {
     let mut s = format!("### {title} ({table})\n\n");
@@ -253,9 +398,8 @@ pub fn markdown_head(title: &str, table: &str, m: &Machine) -> String {
         m.cores,
         m.cpu_bandwidth / 1e9
     );
-    if let (Some(g), Some(b)) = (&m.gpu, m.gpu_bandwidth) {
-        s +=
-            &format!("; GPU {g}, copy bandwidth {:.1} GB/s, timed by {}", b / 1e9, m.gpu_clock.unwrap_or("wall clock"));
+    if let Some(g) = &m.gpu {
+        s += &format!("; GPU {g}, {}, timed by {}", gpu_figures(m), m.gpu_clock.unwrap_or("wall clock"));
     }
     s += &format!(".\nDate {}. Command `{}`.\n\n", m.date, m.command);
     s

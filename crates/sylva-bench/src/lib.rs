@@ -24,7 +24,7 @@ pub mod tables;
 pub mod zioma;
 
 use anyhow::{Context, Result, bail};
-use harness::{Env, Machine, cpu_bandwidth, cpu_model, gpu_bandwidth};
+use harness::{Env, Machine, cpu_bandwidth, cpu_model, gpu_bandwidth, gpu_figures, gpu_probes};
 use std::path::PathBuf;
 use sylva_core::species::SpeciesSource;
 
@@ -96,6 +96,12 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
     };
     let time_cpu = args.backend != Backends::Gpu;
     let tree = SpeciesSource::resolve(&args.species)?.generate(1, &Default::default(), None)?;
+    let buffer_copy = ctx.map(gpu_bandwidth).transpose()?;
+    let probes = match ctx {
+        Some(c) => gpu_probes(c)?,
+        None => None,
+    };
+    let kernel_copy = probes.map(|p| p.kernel_copy);
     let machine = Machine {
         cpu: cpu_model(),
         cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
@@ -105,10 +111,11 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
             None => format!("{}, no fixed subgroup size", c.summary),
         }),
         cpu_bandwidth: cpu_bandwidth(),
-        gpu_bandwidth: match ctx {
-            Some(c) => Some(gpu_bandwidth(c)?),
-            None => None,
-        },
+        gpu_bandwidth: buffer_copy.map(|b| kernel_copy.map_or(b, |k| b.max(k))),
+        gpu_buffer_copy: buffer_copy,
+        gpu_kernel_copy: kernel_copy,
+        gpu_dispatch: probes.map(|p| p.dispatch),
+        gpu_pass: probes.map(|p| p.pass),
         gpu_clock: ctx.map(|c| if c.timestamps { "timestamp queries" } else { "wall clock" }),
         date: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
         command: std::env::args().collect::<Vec<_>>().join(" "),
@@ -119,8 +126,8 @@ pub fn run(args: &BenchArgs) -> Result<Vec<PathBuf>> {
         machine.threads,
         machine.cpu_bandwidth / 1e9
     );
-    if let (Some(g), Some(b), Some(clock)) = (&machine.gpu, machine.gpu_bandwidth, machine.gpu_clock) {
-        println!("GPU: {g}, copy bandwidth {:.1} GB/s, timed by {clock}", b / 1e9);
+    if let (Some(g), Some(clock)) = (&machine.gpu, machine.gpu_clock) {
+        println!("GPU: {g}, {}, timed by {clock}", gpu_figures(&machine));
     }
     let env = Env { quick: args.quick, budget, time_cpu, ctx, out_dir: &args.out_dir, machine: &machine };
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("creating {}", args.out_dir.display()))?;

@@ -36,6 +36,14 @@ fn render_default_scene_writes_gif_and_frames() {
     for m in ["zioma", "akagi", "skjermo", "hsm"] {
         assert!(out.contains(&format!("· {m}")), "{m} missing:\n{out}");
     }
+    // The per-frame breakdown, and the GPU's own time for simulation and meshing where the
+    // adapter has timestamp queries.
+    assert!(out.contains("ms per frame (simulate + mesh recording"), "{out}");
+    if sylva_gpu::GpuContext::shared().is_ok_and(|c| c.timestamps) {
+        let line = out.lines().find(|l| l.starts_with("GPU time of simulation + meshing")).expect("GPU time line");
+        let ms: f64 = line.split(": ").nth(1).and_then(|v| v.split(' ').next()).unwrap().parse().unwrap();
+        assert!(ms > 0.0, "{line}");
+    }
     let gif = dir.path().join("out/render/sylva.gif");
     let decoder =
         image::codecs::gif::GifDecoder::new(std::io::BufReader::new(std::fs::File::open(&gif).unwrap())).unwrap();
@@ -605,6 +613,19 @@ fn bench_quick_writes_complete_tables() {
                 .unwrap();
         assert_eq!(json["table"], table);
         assert!(json["machine"]["cpu_bandwidth"].as_f64().unwrap() > 0.0);
+        if gpu && sylva_gpu::GpuContext::shared().unwrap().timestamps {
+            // The machine probes: the faster copy is the bandwidth the rows are set against,
+            // and a dependent dispatch takes some time, well under a second.
+            let m = &json["machine"];
+            let (copy, kernel) = (m["gpu_buffer_copy"].as_f64().unwrap(), m["gpu_kernel_copy"].as_f64().unwrap());
+            assert!(copy > 0.0 && kernel > 0.0, "{m}");
+            assert_eq!(m["gpu_bandwidth"].as_f64().unwrap(), copy.max(kernel), "{m}");
+            let dispatch = m["gpu_dispatch"].as_f64().unwrap();
+            assert!(dispatch > 0.0 && dispatch < 1.0, "{m}");
+            let pass = m["gpu_pass"].as_f64().unwrap();
+            assert!(pass > 0.0 && pass < 1.0, "{m}");
+            assert!(out.contains("dependent dispatch"), "{out}");
+        }
         assert!(json["machine"]["command"].as_str().unwrap().contains("bench all"));
         let rows = json["rows"].as_array().unwrap();
         assert_eq!(rows.len(), 3, "--quick runs the three smallest sizes");
