@@ -28,6 +28,7 @@ use sylva_core::model::{RawLeaf, RawSegment};
 use sylva_core::pose::seam_buffers;
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
+use sylva_gpu::mesh::MeshParts;
 
 /// One row.
 #[derive(Debug, Clone, Serialize)]
@@ -59,6 +60,9 @@ pub struct AkagiRow {
     pub gpu_direct_ms: Option<[f64; 3]>,
     /// The GPU's commands per frame.
     pub gpu_commands: Option<Commands>,
+    /// GPU ms per frame of each kernel alone (`GpuMesh::set_parts`, runs staged), medians:
+    /// `mesh_tubes`, `mesh_detail`, `mesh_leaves`.
+    pub gpu_kernel_ms: Option<[f64; 3]>,
     /// CPU (all threads) bytes/s over the measured copy bandwidth.
     pub cpu_bandwidth_fraction: Option<f64>,
     /// GPU bytes/s over the measured copy bandwidth.
@@ -149,9 +153,19 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         let info = layout.info();
         let mut tubes = vec![bytemuck::Zeroable::zeroed(); layout.tube_vertex_count()];
         let mut leaves = vec![bytemuck::Zeroable::zeroed(); layout.leaf_vertex_count()];
+        let rim = layout.leaf_rim_table();
         let mut frame = || {
             sylva_core::mesh::mesh_tubes(&info, &layout.rings, &layout.segments, &joint, &acc, &mut tubes);
-            sylva_core::mesh::mesh_leaves(&info, &layout.leaves, &layout.segments, &joint, &acc, &[], &mut leaves);
+            sylva_core::mesh::mesh_leaves(
+                &info,
+                &layout.leaves,
+                &layout.segments,
+                &joint,
+                &acc,
+                &[],
+                &rim,
+                &mut leaves,
+            );
         };
         let (cpu_one, cpu_all) = if time_cpu {
             let one = one_thread.install(|| {
@@ -168,7 +182,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         } else {
             (None, None)
         };
-        let (gpu, gpu_direct, gpu_commands) = match ctx {
+        let (gpu, gpu_direct, gpu_commands, gpu_kernel_ms) = match ctx {
             Some(c) => {
                 let mut mesh = sylva_gpu::mesh::GpuMesh::new(c, &layout)?;
                 let jb = sylva_gpu::kernel::upload(c, "bench joints", &joint)?;
@@ -187,9 +201,15 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
                 let (staged, commands) = time(&mesh)?;
                 mesh.set_staged(c, false);
                 let (direct, _) = time(&mesh)?;
-                (Some(staged), Some(direct), Some(commands))
+                mesh.set_staged(c, true);
+                let mut kernels = [0.0; 3];
+                for (k, ms) in kernels.iter_mut().enumerate() {
+                    mesh.set_parts(MeshParts { tubes: k == 0, detail: k == 1, leaves: k == 2 });
+                    *ms = time(&mesh)?.0.ms()[0];
+                }
+                (Some(staged), Some(direct), Some(commands), Some(kernels))
             }
-            None => (None, None, None),
+            None => (None, None, None, None),
         };
         let row = AkagiRow {
             paper_triangles,
@@ -205,19 +225,27 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             gpu_ms: gpu.map(|r| r.ms()),
             gpu_direct_ms: gpu_direct.map(|r| r.ms()),
             gpu_commands,
+            gpu_kernel_ms,
             cpu_bandwidth_fraction: cpu_all.map(|r| r.median * bytes as f64 / cpu_bw),
             gpu_bandwidth_fraction: gpu.zip(gpu_bw).map(|(r, b)| r.median * bytes as f64 / b),
         };
         bar.suspend(|| {
             println!(
-                "{:>9} triangles ({} trees): CPU 1 thread {} ms, all threads {} ms, GPU {} ms (paper CPU {:.2}, GPU {:.3})",
+                "{:>9} triangles ({} trees): CPU 1 thread {} ms, all threads {} ms, GPU {} ms (paper CPU {:.2}, GPU {:.3}){}",
                 row.triangles,
                 row.trees,
                 cell(row.cpu_one_ms),
                 cell(row.cpu_all_ms),
                 cell(row.gpu_ms),
                 row.paper_cpu_ms,
-                row.paper_gpu_ms
+                row.paper_gpu_ms,
+                row.gpu_kernel_ms.map_or(String::new(), |[t, d, l]| {
+                    let i = layout.info();
+                    format!(
+                        "; alone: {} rings {t:.3} ms, {} midpoints {d:.3} ms, {} leaves {l:.3} ms",
+                        i.rings, i.details, i.leaves
+                    )
+                })
             )
         });
         out.push(row);
@@ -228,17 +256,17 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
     let mut md = markdown_head("Akagi & Kitajima Table 2: mesh regeneration per frame", "akagi-t2", env.machine);
     md += "ms per frame, median (min–max). The paper: Core2 QX9650 one thread, GeForce GTX 280, generation + drawing.\n\n";
     md += &format!(
-        "| paper triangles | paper CPU ms | paper GPU ms | paper CPU/GPU | triangles | trees | MB/frame | B/triangle | CPU 1 thread ms | CPU all threads ms | CPU % of bandwidth | GPU ms | GPU ms, runs direct | GPU % of bandwidth | CPU 1 thread / GPU | CPU all / GPU | {} |\n",
+        "| paper triangles | paper CPU ms | paper GPU ms | paper CPU/GPU | triangles | trees | MB/frame | B/triangle | CPU 1 thread ms | CPU all threads ms | CPU % of bandwidth | GPU ms | GPU ms, runs direct | GPU ms, tubes / detail / leaves alone | GPU % of bandwidth | CPU 1 thread / GPU | CPU all / GPU | {} |\n",
         COMMANDS_HEADING.replace("step", "frame")
     );
-    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    md += "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let ratio = |a: Option<[f64; 3]>, b: Option<[f64; 3]>| match (a, b) {
         (Some(a), Some(b)) => format!("{:.1}", a[0] / b[0]),
         _ => "–".into(),
     };
     for r in &out {
         md += &format!(
-            "| {} | {:.2} | {:.3} | {:.0} | {} | {} | {:.1} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {:.2} | {:.3} | {:.0} | {} | {} | {:.1} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.paper_triangles,
             r.paper_cpu_ms,
             r.paper_gpu_ms,
@@ -252,6 +280,7 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
             r.cpu_bandwidth_fraction.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f)),
             cell(r.gpu_ms),
             cell(r.gpu_direct_ms),
+            r.gpu_kernel_ms.map_or("–".into(), |[t, d, l]| format!("{t:.3} / {d:.3} / {l:.3}")),
             r.gpu_bandwidth_fraction.map_or("–".into(), |f| format!("{:.1} %", 100.0 * f)),
             ratio(r.cpu_one_ms, r.gpu_ms),
             ratio(r.cpu_all_ms, r.gpu_ms),

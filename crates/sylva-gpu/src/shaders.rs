@@ -100,8 +100,6 @@ pub const MESH: &str = include_str!("mesh/mesh.wgsl");
 pub const MESH_TUBES: &str = include_str!("mesh/mesh_tubes.wgsl");
 /// Kernel: midpoint vertices of subdivided bark bands (§2.3).
 pub const MESH_DETAIL: &str = include_str!("mesh/mesh_detail.wgsl");
-/// Leaf outlines: `leaf_radius`, `leaf_rim`, `inside_leaf_shape` (twin of `sylva_core::model::leaf_shape`).
-pub const LEAF_SHAPE: &str = include_str!("wgsl/leaf_shape.wgsl");
 /// Kernel: leaf-polygon vertices.
 pub const MESH_LEAVES: &str = include_str!("mesh/mesh_leaves.wgsl");
 /// Kernel: two-bone skinning of a rest mesh, instance-major.
@@ -161,7 +159,7 @@ kernels! {
     leaf_flutter: [QUAT, NOISE, LEAVES, LEAF_FLUTTER] => sylva_core::leaves::kernels::leaf_flutter;
     mesh_tubes: [QUAT, TREE, NOISE, MESH, VERTEX, VERTEX_STAGE, MESH_TUBES] => sylva_core::mesh::mesh_tubes;
     mesh_detail: [NOISE, MESH, VERTEX, MESH_DETAIL] => sylva_core::mesh::mesh_detail;
-    mesh_leaves: [QUAT, TREE, NOISE, MESH, VERTEX, VERTEX_STAGE, LEAF_SHAPE, MESH_LEAVES] => sylva_core::mesh::mesh_leaves;
+    mesh_leaves: [QUAT, TREE, NOISE, MESH, VERTEX, VERTEX_STAGE, MESH_LEAVES] => sylva_core::mesh::mesh_leaves;
     skin_vertices: [QUAT, NOISE, MESH, VERTEX, SKIN_VERTICES] => sylva_core::mesh::skin_vertices;
     skjermo_deform: [QUAT, TREE, NOISE, MESH, VERTEX, VERTEX_STAGE, SKJERMO, SKJERMO_DEFORM] => sylva_core::mesh::skjermo_deform;
 }

@@ -73,8 +73,8 @@ fn gpu_mesh_matches_cpu_on_every_preset_and_random_poses() {
     }
 }
 
-/// Every leaf outline (`leaf_rim` in `leaf_shape.wgsl` and its CPU twin), on random poses
-/// and polygon sizes, within the same bounds.
+/// Every leaf outline (row `shape` of the rim table both twins read), on random poses and
+/// polygon sizes, within the same bounds.
 #[test]
 fn every_leaf_shape_meshes_alike_on_cpu_and_gpu() {
     let Some(ctx) = common::gpu() else { return };

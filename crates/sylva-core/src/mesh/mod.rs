@@ -575,7 +575,8 @@ impl MeshLayout {
         crate::mesh::mesh_tubes(&info, &self.rings, &self.segments, joint, acc, &mut tubes[..ring_vertices]);
         crate::mesh::mesh_detail(&info, &self.details, &mut tubes, &self.rings);
         let mut leaves = vec![RawVertex::zeroed(); self.leaf_vertex_count()];
-        crate::mesh::mesh_leaves(&info, &self.leaves, &self.segments, joint, acc, leaf_rotation, &mut leaves);
+        let rim = self.leaf_rim_table();
+        crate::mesh::mesh_leaves(&info, &self.leaves, &self.segments, joint, acc, leaf_rotation, &rim, &mut leaves);
         MeshFrame { tubes, leaves }
     }
 }

@@ -37,6 +37,13 @@ impl MeshLayout {
         uv
     }
 
+    /// Every leaf shape's rim of `leaf_sides` points, shape after shape, then the row an
+    /// unknown shape index gets ([`leaf_rims`]): the `leaf_rim` binding of `mesh_leaves`,
+    /// made once so that no kernel evaluates an outline per vertex and frame.
+    pub fn leaf_rim_table(&self) -> Vec<Uv> {
+        leaf_rims(self.params.leaf_sides).concat()
+    }
+
     /// Leaf texture coordinates, one per leaf vertex: the centre (0.5, 0.5), then the rim of
     /// the leaf's outline (`leaf_rim`), as `mesh_leaves` places them.
     pub fn leaf_uv(&self) -> Vec<Uv> {

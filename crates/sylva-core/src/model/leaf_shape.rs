@@ -2,7 +2,8 @@
 //! square — u across (0.5 the midrib), v from the attachment (0) to the tip (1); the mesh
 //! scales the square to the leaf's width and length. The leaf mesher's polygon holds the
 //! outline, and the renderer's fragment test and the exported texture's alpha cut it
-//! (`leaf_shape.wgsl` is the WGSL twin of [`LeafShape::radius`] and [`LeafShape::rim`]).
+//! (the renderer's `leaf_shape.wgsl` is the WGSL twin of [`LeafShape::radius`]; the rims
+//! are made here once per mesh layout and read by both mesher twins).
 //!
 //! | index | name | outline |
 //! | ---: | --- | --- |
@@ -98,7 +99,7 @@ impl LeafShape {
     /// Rim vertex `k` of `sides` of the leaf polygon, (u, v): the disc's ellipse of two
     /// half-circles about the circle that holds the blade, or for the polar shapes a polygon
     /// that holds the outline ([`leaf_rim`]). Either may reach a few hundredths past the
-    /// square, where the texture's border is clear. As `leaf_rim` in `leaf_shape.wgsl`.
+    /// square, where the texture's border is clear.
     pub fn rim(self, k: u32, sides: u32) -> (f32, f32) {
         leaf_rim(self.index(), k, sides)
     }
@@ -161,7 +162,7 @@ const RIM_SAMPLES: u32 = 16;
 /// Margin for what the samples miss between them.
 const RIM_MARGIN: f32 = 1.02;
 
-/// [`LeafShape::rim`] by index: same operations as `leaf_rim` in `leaf_shape.wgsl`. In the
+/// [`LeafShape::rim`] by index (`MeshLayout::leaf_rim_table` holds every shape's). In the
 /// outline stretched by `leaf_box` to about a circle, vertex k sits at angle π − k·step
 /// (from the base through +u); its radius keeps both chords beside it outside every sampled
 /// outline point of their sectors (a chord with both ends at R passes at R cos(φ − mid) /

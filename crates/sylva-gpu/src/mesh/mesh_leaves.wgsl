@@ -1,7 +1,8 @@
 // mesh_leaves: one leaf per invocation (Akagi §2.4): the leaf's transform once, then its
-// polygon — k = 0 the centre, 1.. the rim (leaf_rim: the disc's two half-circles, or a
-// polygon holding the leaf's outline), scaled to the blade, turned by the leaf's rotation;
-// the workgroup's leaves written out together (vertex_stage.wgsl).
+// polygon — k = 0 the centre, 1.. the rim (the disc's two half-circles, or a polygon holding
+// the leaf's outline: row `shape` of the table `leaf_rim`, made once on the CPU), scaled to
+// the blade, turned by the leaf's rotation; the workgroup's leaves written out together
+// (vertex_stage.wgsl).
 // CPU twin: sylva_core::mesh::mesh_leaves (same bindings, same loop body).
 
 @group(0) @binding(0) var<storage, read> info: MeshInfo;
@@ -11,6 +12,7 @@
 @group(0) @binding(4) var<storage, read> acc: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> vertex_words: array<u32>;
 @group(0) @binding(6) var<storage, read> leaf_rotation: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> leaf_rim: array<vec2<f32>>;
 
 @compute @workgroup_size(64)
 fn main(
@@ -46,10 +48,12 @@ fn leaf_vertices(l: u32, lane: u32, stride: u32, staged: bool) {
     let qx = quat_rotate(q, vec3<f32>(1.0, 0.0, 0.0));
     let qy = quat_rotate(q, vec3<f32>(0.0, 1.0, 0.0));
     let normal = quat_rotate(q, vec3<f32>(0.0, 0.0, 1.0));
+    let sides = max(info.leaf_sides, 1u);
+    let row = min(lf.shape, max(arrayLength(&leaf_rim) / sides, 1u) - 1u) * sides;
     for (var k = 0u; k < stride; k++) {
         var uv = vec2<f32>(0.5, 0.5);
         if (k > 0u) {
-            uv = leaf_rim(lf.shape, k - 1u, info.leaf_sides);
+            uv = leaf_rim[row + k - 1u];
         }
         let p = base + qx * ((uv.x - 0.5) * lf.width) + qy * (uv.y * lf.length);
         put_vertex(staged, lane * stride + k, l * stride + k, vertex_new(p, normal));

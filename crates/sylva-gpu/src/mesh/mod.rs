@@ -33,6 +33,8 @@ pub struct GpuMesh {
     acc: wgpu::Buffer,
     /// Leaf rotations used when the pose comes from the CPU (the identity: leaves at rest).
     leaf_rotation: wgpu::Buffer,
+    /// Every leaf shape's rim ([`MeshLayout::leaf_rim_table`]), made once.
+    leaf_rim: wgpu::Buffer,
     /// Bark vertices (storage + vertex buffer).
     pub tube_vertices: wgpu::Buffer,
     /// Bark triangle indices.
@@ -60,6 +62,25 @@ pub struct GpuMesh {
     /// The kernels bound to the last pose buffers meshed (a method's are the same every
     /// frame).
     plan: PlanCache,
+    parts: MeshParts,
+}
+
+/// Which of the mesh kernels [`GpuMesh::record`] runs (all by default); a benchmark times
+/// them one at a time ([`GpuMesh::set_parts`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MeshParts {
+    /// `mesh_tubes`: the rings' vertices.
+    pub tubes: bool,
+    /// `mesh_detail`: the subdivided bands' midpoints (reads the rings' vertices).
+    pub detail: bool,
+    /// `mesh_leaves`: the leaves' vertices.
+    pub leaves: bool,
+}
+
+impl Default for MeshParts {
+    fn default() -> Self {
+        Self { tubes: true, detail: true, leaves: true }
+    }
 }
 
 pub(crate) fn vertex_buffer(ctx: &GpuContext, label: &'static str, len: usize) -> Result<wgpu::Buffer, GpuError> {
@@ -117,6 +138,13 @@ impl GpuMesh {
         self.plan = Default::default();
     }
 
+    /// Runs only the kernels in `parts` from the next [`Self::record`] on (all by default);
+    /// a kernel left out leaves its vertices as they were.
+    pub fn set_parts(&mut self, parts: MeshParts) {
+        self.parts = parts;
+        self.plan = Default::default();
+    }
+
     /// Whether runs are staged ([`Self::set_staged`]).
     pub fn staged(&self) -> bool {
         self.staged
@@ -147,6 +175,7 @@ impl GpuMesh {
             leaf_indices: index_buffer(ctx, "leaf indices", &layout.leaf_indices),
             tube_uv: uv_buffer(ctx, "tube uv", &layout.tube_uv()),
             leaf_uv: uv_buffer(ctx, "leaf uv", &layout.leaf_uv()),
+            leaf_rim: static_buffer(ctx, "leaf rims", &layout.leaf_rim_table(), wgpu::BufferUsages::STORAGE),
             tube_index_count: layout.tube_indices.len() as u32,
             leaf_index_count: layout.leaf_indices.len() as u32,
             tube_vertex_count: layout.tube_vertex_count(),
@@ -158,6 +187,7 @@ impl GpuMesh {
             leaf_slots: layout.leaf_slots as usize,
             staged: true,
             plan: Default::default(),
+            parts: MeshParts::default(),
         })
     }
 
@@ -188,17 +218,25 @@ impl GpuMesh {
             // One pass: the detail kernel reads the rings' vertices the tube kernel wrote,
             // which the barrier between dispatches orders.
             let mut plan = Plan::default();
-            if self.ring_count > 0 {
+            if self.ring_count > 0 && self.parts.tubes {
                 let buffers = [&self.info, &self.rings, &self.segments, joint, acc, &self.tube_vertices];
                 plan.push(ctx, &self.tubes, &buffers, self.ring_count as u32);
             }
-            if self.detail_count > 0 {
+            if self.detail_count > 0 && self.parts.detail {
                 let buffers = [&self.info, &self.details, &self.tube_vertices, &self.rings];
                 plan.push(ctx, &self.detail_kernel, &buffers, self.detail_count as u32);
             }
-            if self.leaf_count > 0 {
-                let buffers =
-                    [&self.info, &self.leaves, &self.segments, joint, acc, &self.leaf_vertices, leaf_rotation];
+            if self.leaf_count > 0 && self.parts.leaves {
+                let buffers = [
+                    &self.info,
+                    &self.leaves,
+                    &self.segments,
+                    joint,
+                    acc,
+                    &self.leaf_vertices,
+                    leaf_rotation,
+                    &self.leaf_rim,
+                ];
                 plan.push(ctx, &self.leaves_kernel, &buffers, self.leaf_count as u32);
             }
             plan

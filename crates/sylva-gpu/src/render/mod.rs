@@ -15,7 +15,7 @@ use wgpu::util::DeviceExt;
 
 /// The renderer's WGSL (validated by naga in the tests).
 pub const RENDER_WGSL: &str =
-    concat!(include_str!("../wgsl/leaf_shape.wgsl"), include_str!("../mesh/vertex.wgsl"), include_str!("render.wgsl"));
+    concat!(include_str!("leaf_shape.wgsl"), include_str!("../mesh/vertex.wgsl"), include_str!("render.wgsl"));
 
 const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
