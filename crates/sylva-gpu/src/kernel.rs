@@ -111,10 +111,16 @@ impl Kernel {
     /// times ([`Self::dispatch`], [`Plan`]): creating a bind group is most of
     /// what recording a small dispatch costs the CPU.
     pub fn bind(&self, ctx: &GpuContext, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
-        let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
+        self.bind_resources(ctx, &buffers.iter().map(|b| b.as_entire_binding()).collect::<Vec<_>>())
+    }
+
+    /// A bind group of `resources` at bindings 0, 1, 2, … (a buffer's range, where a kernel
+    /// reads one element of a larger buffer).
+    pub fn bind_resources(&self, ctx: &GpuContext, resources: &[wgpu::BindingResource<'_>]) -> wgpu::BindGroup {
+        let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
             .iter()
             .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+            .map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() })
             .collect();
         Counters::add(&ctx.counters.bind_groups);
         ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -213,6 +219,17 @@ impl Plan {
         invocations: u32,
     ) {
         self.0.push((kernel.clone(), kernel.bind(ctx, buffers), invocations));
+    }
+
+    /// Appends a dispatch of `kernel` over `invocations` with `resources` bound at 0, 1, 2, …
+    pub fn push_resources(
+        &mut self,
+        ctx: &GpuContext,
+        kernel: &std::sync::Arc<Kernel>,
+        resources: &[wgpu::BindingResource<'_>],
+        invocations: u32,
+    ) {
+        self.0.push((kernel.clone(), kernel.bind_resources(ctx, resources), invocations));
     }
 
     /// Records every dispatch, in order, in one pass labelled `label` (none when empty).

@@ -12,7 +12,7 @@ use sylva_core::methods::zioma::{Zioma, ZiomaParams};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 use sylva_gpu::methods::GpuAnimator;
-use sylva_gpu::methods::hsm::GpuHsm;
+use sylva_gpu::methods::hsm::{GpuHsm, SUBSTEPS_PER_PASS};
 use sylva_gpu::methods::skjermo::GpuSkjermo;
 use sylva_gpu::methods::zioma::GpuZioma;
 use sylva_gpu::wind::GpuWind;
@@ -37,26 +37,29 @@ fn steps_record_their_dispatches_in_one_pass_on_bind_groups_made_once() {
     let calm = GpuWind::calm(ctx).unwrap();
     let dt = 1.0 / 60.0;
 
-    // HSM: every substep is stage 1 and the fused particle pass in one pass; the pose
-    // (cluster rotations, joints, leaves) is written once per submission.
+    // HSM: every substep is stage 1 and the fused particle pass, up to SUBSTEPS_PER_PASS
+    // substeps in one pass (each reading its own slot of parameters); the pose (cluster
+    // rotations, joints, leaves) is written once per submission, in a pass of its own.
     let hsm = Arc::new(Hsm::new(&tree, HsmParams::default()).unwrap());
     assert!(hsm.params.fused);
     let substeps = hsm.substeps(dt) as u64;
+    let per_pass = SUBSTEPS_PER_PASS as u64;
     let mut g = GpuHsm::new(ctx, Some(tree.clone()), hsm, &gpu_wind).unwrap();
     let first = counted(ctx, || g.advance_steps(ctx, dt, 1));
-    assert!(first.bind_groups >= 2, "the first step binds its kernels: {first:?}");
+    assert_eq!(first.bind_groups, 2 * per_pass, "each slot binds its two kernels, once: {first:?}");
     let frames = 4;
     let c = counted(ctx, || g.advance_steps(ctx, dt, frames));
     let pose = first.dispatches - 2 * substeps;
+    let all = substeps * frames as u64;
     assert_eq!(c.submissions, 1, "{c:?}");
     assert_eq!(c.bind_groups, 0, "bind groups made once: {c:?}");
-    assert_eq!(c.dispatches, 2 * substeps * frames as u64 + pose, "{c:?}");
-    assert_eq!(c.passes, substeps * frames as u64 + 1, "a substep's dispatches share a pass, the pose's too: {c:?}");
+    assert_eq!(c.dispatches, 2 * all + pose, "{c:?}");
+    assert_eq!(c.passes, all.div_ceil(per_pass) + 1, "substeps share a pass, the pose's dispatches too: {c:?}");
     println!("HSM, {substeps} substeps per step, {frames} steps in one call: {c:?}");
     // A new wind binds again, once.
     g.set_wind(&calm);
     let c = counted(ctx, || g.advance_steps(ctx, dt, 2));
-    assert_eq!(c.bind_groups, 2, "stage 1 and the particle pass bound to the new wind: {c:?}");
+    assert_eq!(c.bind_groups, 2 * per_pass, "stage 1 and the particle pass bound to the new wind: {c:?}");
 
     // Skjermo: a frame's steps in one submission, one dispatch each, the pose once.
     let m = Skjermo::new(&tree, SkjermoParams::default());

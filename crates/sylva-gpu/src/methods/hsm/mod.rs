@@ -45,10 +45,15 @@ pub struct GpuHsm {
     segment_cluster: wgpu::Buffer,
     leaf_pose_kernel: Arc<Kernel>,
     leaves: wgpu::Buffer,
-    /// The substep parameters of the current submission, one after another.
+    /// The substep parameters of the current submission, one per `step_stride` bytes.
     steps: wgpu::Buffer,
     steps_capacity: usize,
-    step: wgpu::Buffer,
+    /// [`SUBSTEPS_PER_PASS`] substeps' parameters, copied from `steps` before each pass;
+    /// substep k of a pass reads slot k.
+    step_slots: wgpu::Buffer,
+    /// Bytes from one slot to the next: a substep's parameters, rounded up to the device's
+    /// storage-binding offset alignment.
+    step_stride: u64,
     displacement: wgpu::Buffer,
     velocity: wgpu::Buffer,
     state: wgpu::Buffer,
@@ -58,15 +63,19 @@ pub struct GpuHsm {
     /// The pose's dispatches, bound once: segment rotations, then leaf rotations.
     pose_plan: Plan,
     leaf_plan: Plan,
-    /// A substep's dispatches (stage 1, then the fused particle pass or stages 3 and 4),
-    /// bound on first use after the wind is set.
-    substep: Option<Plan>,
+    /// A substep's dispatches (stage 1, then the fused particle pass or stages 3 and 4), one
+    /// plan per slot of `step_slots`, all bound on first use after the wind is set.
+    substep: Option<Vec<Plan>>,
     /// Simulated time, s.
     pub time: f32,
 }
 
 /// Most substeps recorded into one submission by [`GpuHsm::advance_steps`]; longer runs are split.
 pub const MAX_SUBSTEPS_PER_SUBMISSION: usize = 4096;
+
+/// Substeps recorded into one compute pass: their parameters are copied into that many slots
+/// once before the pass, rather than one copy and one pass per substep.
+pub const SUBSTEPS_PER_PASS: usize = 64;
 
 impl GpuHsm {
     /// The pose seam's buffers on the GPU, when built with the tree.
@@ -85,6 +94,8 @@ impl GpuHsm {
             None => None,
         };
         let step = method.step_params(0.0, 0.0);
+        let align = ctx.device.limits().min_storage_buffer_offset_alignment as u64;
+        let stride = (std::mem::size_of::<RawHsmStep>() as u64).div_ceil(align) * align;
         let mut this = Self {
             clusters_kernel: clusters_kernel(ctx, true),
             goals_kernel: Kernel::get(ctx, "hsm_goals"),
@@ -103,9 +114,10 @@ impl GpuHsm {
             segment_cluster: upload(ctx, "hsm segment clusters", &l.segment_cluster)?,
             leaf_pose_kernel: Kernel::get(ctx, "hsm_leaf_pose"),
             leaves: upload(ctx, "hsm leaves", &method.leaves)?,
-            steps: upload(ctx, "hsm substeps", &vec![step; method.params.substeps as usize])?,
-            steps_capacity: method.params.substeps as usize,
-            step: upload(ctx, "hsm step", &[step])?,
+            steps: step_buffer(ctx, "hsm substeps", stride, SUBSTEPS_PER_PASS),
+            steps_capacity: SUBSTEPS_PER_PASS,
+            step_slots: upload(ctx, "hsm step slots", &slots(&vec![step; SUBSTEPS_PER_PASS], stride))?,
+            step_stride: stride,
             displacement: upload(ctx, "hsm displacements", &rest_state.displacement)?,
             velocity: upload(ctx, "hsm velocities", &rest_state.velocity)?,
             state: upload(ctx, "hsm cluster state", &rest_state.clusters)?,
@@ -180,22 +192,26 @@ impl GpuHsm {
                     RawHsmStep { sample_wind: (k % n == 0) as u32, ..method.step_params(self.time, h) }
                 })
                 .collect();
+            let stride = self.step_stride;
             if batch > self.steps_capacity {
-                self.steps = output::<RawHsmStep>(ctx, "hsm substeps", batch).expect("substep parameters fit");
+                self.steps = step_buffer(ctx, "hsm substeps", stride, batch);
                 self.steps_capacity = batch;
             }
-            ctx.queue.write_buffer(&self.steps, 0, bytemuck::cast_slice(&params));
+            ctx.queue.write_buffer(&self.steps, 0, &slots(&params, stride));
             let mut e = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hsm") });
-            let substep = match self.substep.take() {
+            let plans = match self.substep.take() {
                 Some(p) => p,
-                None => self.plan_substep(ctx),
+                None => (0..SUBSTEPS_PER_PASS).map(|k| self.plan_substep(ctx, k)).collect(),
             };
-            let size = std::mem::size_of::<RawHsmStep>() as u64;
-            for k in 0..batch {
-                e.copy_buffer_to_buffer(&self.steps, k as u64 * size, &self.step, 0, size);
-                substep.record(ctx, &mut e, "hsm substep");
+            for first in (0..batch).step_by(SUBSTEPS_PER_PASS) {
+                let count = (batch - first).min(SUBSTEPS_PER_PASS);
+                e.copy_buffer_to_buffer(&self.steps, first as u64 * stride, &self.step_slots, 0, count as u64 * stride);
+                let mut pass = compute_pass(ctx, &mut e, "hsm substeps");
+                for plan in &plans[..count] {
+                    plan.dispatch(ctx, &mut pass);
+                }
             }
-            self.substep = Some(substep);
+            self.substep = Some(plans);
             done += batch;
             if done == total {
                 self.record_pose(ctx, &mut e);
@@ -204,36 +220,52 @@ impl GpuHsm {
         }
     }
 
-    fn plan_substep(&self, ctx: &GpuContext) -> Plan {
+    /// The dispatches of the substep that reads slot `slot` of `step_slots`.
+    fn plan_substep(&self, ctx: &GpuContext, slot: usize) -> Plan {
         let lanes = sylva_core::methods::hsm::kernels::LANES as u32;
+        let step = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.step_slots,
+            offset: slot as u64 * self.step_stride,
+            size: std::num::NonZeroU64::new(std::mem::size_of::<RawHsmStep>() as u64),
+        });
+        fn all(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+            b.as_entire_binding()
+        }
         let mut plan = Plan::default();
-        let buffers = [
-            &self.wind.fields,
-            &self.wind.waves,
-            &self.info,
-            &self.clusters,
-            &self.slots,
-            &self.displacement,
-            &self.step,
-            &self.state,
+        let resources = [
+            all(&self.wind.fields),
+            all(&self.wind.waves),
+            all(&self.info),
+            all(&self.clusters),
+            all(&self.slots),
+            all(&self.displacement),
+            step.clone(),
+            all(&self.state),
         ];
-        plan.push(ctx, &self.clusters_kernel, &buffers, self.n_clusters as u32 * lanes);
+        plan.push_resources(ctx, &self.clusters_kernel, &resources, self.n_clusters as u32 * lanes);
         let n = self.n_particles as u32;
         if self.fused {
-            let buffers = [
-                &self.member_offset,
-                &self.member,
-                &self.state,
-                &self.owner,
-                &self.step,
-                &self.displacement,
-                &self.velocity,
+            let resources = [
+                all(&self.member_offset),
+                all(&self.member),
+                all(&self.state),
+                all(&self.owner),
+                step,
+                all(&self.displacement),
+                all(&self.velocity),
             ];
-            plan.push(ctx, &self.particles_kernel, &buffers, n);
+            plan.push_resources(ctx, &self.particles_kernel, &resources, n);
         } else {
             plan.push(ctx, &self.goals_kernel, &[&self.member_offset, &self.member, &self.state, &self.goal], n);
-            let buffers = [&self.owner, &self.state, &self.goal, &self.step, &self.displacement, &self.velocity];
-            plan.push(ctx, &self.integrate_kernel, &buffers, n);
+            let resources = [
+                all(&self.owner),
+                all(&self.state),
+                all(&self.goal),
+                step,
+                all(&self.displacement),
+                all(&self.velocity),
+            ];
+            plan.push_resources(ctx, &self.integrate_kernel, &resources, n);
         }
         plan
     }
@@ -341,4 +373,25 @@ impl GpuAnimator for GpuHsm {
     fn particles(&self) -> Option<usize> {
         Some(self.n_particles)
     }
+}
+
+/// `params` laid out one per `stride` bytes (the gaps zero).
+fn slots(params: &[RawHsmStep], stride: u64) -> Vec<u8> {
+    let size = std::mem::size_of::<RawHsmStep>();
+    let mut bytes = vec![0u8; params.len() * stride as usize];
+    for (chunk, p) in bytes.chunks_exact_mut(stride as usize).zip(params) {
+        chunk[..size].copy_from_slice(bytemuck::bytes_of(p));
+    }
+    bytes
+}
+
+/// A buffer for `count` substeps' parameters at `stride` bytes, filled by writes and read
+/// by copies.
+fn step_buffer(ctx: &GpuContext, label: &'static str, stride: u64, count: usize) -> wgpu::Buffer {
+    ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: stride * count as u64,
+        usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
 }
