@@ -642,14 +642,15 @@ fn bench_quick_writes_complete_tables() {
             assert!(cpu["median"].as_f64().unwrap() <= cpu["max"].as_f64().unwrap());
             assert!(cpu["samples"].as_u64().unwrap() >= 3);
             assert_eq!(r["gpu"].is_null(), !gpu);
-            // The work model: a step's two dispatches (stage 1, the fused particle pass)
-            // per substep share a pass on bind groups made once; a sample is one submission.
+            // The work model: a substep's two dispatches (stage 1, the fused particle pass),
+            // up to 64 substeps to a pass, on bind groups made once; a sample is one
+            // submission.
             let commands = &r["gpu_commands"];
             assert_eq!(commands.is_null(), !gpu);
             if gpu {
                 let [d, p, b, s] =
                     ["dispatches", "passes", "bind_groups", "submissions"].map(|k| commands[k].as_f64().unwrap());
-                assert!(d >= 2.0 && d == 2.0 * p && b == 0.0 && s < 1.0, "{commands}");
+                assert!(d >= 2.0 && p < 1.0 && p <= d / 2.0 && b == 0.0 && s < 1.0, "{commands}");
             }
         }
         let md = std::fs::read_to_string(dir.path().join(format!("b/{table}.md"))).unwrap();
