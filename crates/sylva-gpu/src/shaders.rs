@@ -148,8 +148,8 @@ kernels! {
     skjermo_step: [QUAT, TREE, NOISE, WIND, OSCILLATOR, SKJERMO, SKJERMO_STEP] => sylva_core::methods::skjermo::kernels::skjermo_step;
     skjermo_rotations: [QUAT, TREE, SKJERMO, SKJERMO_ROTATIONS] => sylva_core::methods::skjermo::kernels::skjermo_rotations;
     skjermo_rest_orient: [QUAT, TREE, SKJERMO, SKJERMO_REST_ORIENT] => sylva_core::methods::skjermo::kernels::skjermo_rest_orient;
-    hsm_clusters: [QUAT, NOISE, WIND, HSM, HSM_CLUSTER_STAGE, HSM_CLUSTERS] => sylva_core::methods::hsm::kernels::hsm_clusters;
-    hsm_clusters_subgroup: [QUAT, NOISE, WIND, HSM, HSM_CLUSTER_STAGE, HSM_CLUSTERS_SUBGROUP] => sylva_core::methods::hsm::kernels::hsm_clusters_subgroup;
+    hsm_clusters: [QUAT, NOISE, WIND, LEAVES, HSM, HSM_CLUSTER_STAGE, HSM_CLUSTERS] => sylva_core::methods::hsm::kernels::hsm_clusters;
+    hsm_clusters_subgroup: [QUAT, NOISE, WIND, LEAVES, HSM, HSM_CLUSTER_STAGE, HSM_CLUSTERS_SUBGROUP] => sylva_core::methods::hsm::kernels::hsm_clusters_subgroup;
     hsm_goals: [QUAT, HSM, HSM_GATHER, HSM_GOALS] => sylva_core::methods::hsm::kernels::hsm_goals;
     hsm_integrate: [QUAT, HSM, HSM_ADVANCE, HSM_INTEGRATE] => sylva_core::methods::hsm::kernels::hsm_integrate;
     hsm_particles: [QUAT, HSM, HSM_GATHER, HSM_ADVANCE, HSM_PARTICLES] => sylva_core::methods::hsm::kernels::hsm_particles;

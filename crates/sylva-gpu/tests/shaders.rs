@@ -508,7 +508,9 @@ fn hsm_structs_match_their_wgsl_twins() {
             ("vogel_exponent", offset_of!(RawHsmStep, vogel_exponent)),
             ("air", offset_of!(RawHsmStep, air)),
             ("sample_wind", offset_of!(RawHsmStep, sample_wind)),
-            ("_pad", offset_of!(RawHsmStep, _pad)),
+            ("leaf_turbulence", offset_of!(RawHsmStep, leaf_turbulence)),
+            ("flutter_onset", offset_of!(RawHsmStep, flutter_onset)),
+            ("leaf_zeta", offset_of!(RawHsmStep, leaf_zeta)),
         ],
     );
 }

@@ -4,6 +4,7 @@
 //! 64` takes slot `j`) and the same halving tree, so both sides add in the same order (the
 //! GPU's subgroup kernel makes the tree's last strides by shuffles, the same additions).
 
+use crate::leaves::kernels::leaf_band;
 pub use crate::methods::hsm::rotation::{NEWTON_NEAR, extract_rotation, rotation_step};
 use crate::methods::hsm::rotation::{ROTATIONS, extract_rotations_at};
 use crate::methods::hsm::{
@@ -12,6 +13,7 @@ use crate::methods::hsm::{
 use crate::model::NONE;
 use crate::simd::dispatch;
 use crate::wind::lanes::{LANES as WIND_LANES, V3, wind_lanes};
+use crate::wind::noise::{hash_unit, pcg_hash};
 use crate::wind::raw::{RawField, RawWave};
 use glam::{Mat3, Quat, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
@@ -138,7 +140,8 @@ pub(crate) fn hsm_clusters_with<S>(
             }
         }
         if step.sample_wind != 0 && !fields.is_empty() {
-            wind_chunk_at(level, fields, waves, &info[base..base + chunk.len()], &step, chunk);
+            let range = base..base + chunk.len();
+            wind_chunk_at(level, fields, waves, &info[range.clone()], &clusters[range], &step, chunk);
         }
     });
 }
@@ -265,29 +268,58 @@ pub(crate) fn cluster_sums(
 }
 
 dispatch! {
-/// The wind at the centres of one chunk's segment clusters, with its [`reconfiguration`]
-/// in w (a leaf feels the wind sampled for its segment: stage 4 reads it there, and a leaf
-/// cluster's stays still air, w = 1). The WGSL
-/// samples it in the cluster's own invocation; here sixteen centres at a time
-/// ([`crate::wind::lanes`]).
+/// The wind at the centres of one chunk's clusters, with its [`reconfiguration`] in w; a
+/// leaf cluster's adds the air's fluctuation in its band ([`leaf_air`]). The WGSL samples it
+/// in the cluster's own invocation; here sixteen centres at a time ([`crate::wind::lanes`]).
 fn wind_chunk_at(
     fields: &[RawField],
     waves: &[RawWave],
     info: &[RawHsmClusterInfo],
+    clusters: &[RawHsmCluster],
     step: &RawHsmStep,
     state: &mut [RawHsmClusterState],
 ) {
     let time = step.time;
-    let segments: Vec<usize> = (0..state.len()).filter(|&j| info[j].kind != kind::LEAF).collect();
-    for group in segments.chunks(WIND_LANES) {
-        let centre = |l: usize| v3(state[group[l.min(group.len() - 1)]].cm);
+    for (g, group) in state.chunks_mut(WIND_LANES).enumerate() {
+        let base = g * WIND_LANES;
+        let centre = |l: usize| v3(group[l.min(group.len() - 1)].cm);
         let u = wind_lanes(fields, waves, V3::from_lanes(std::array::from_fn(centre)), time);
-        for (l, &j) in group.iter().enumerate() {
+        for (l, st) in group.iter_mut().enumerate() {
             let w = u.lane(l);
-            state[j].wind = [w.x, w.y, w.z, reconfiguration(w, step)];
+            let (inf, cl) = (&info[base + l], &clusters[base + l]);
+            let air = if inf.kind == kind::LEAF { leaf_air(w, cl.aqq_inv[1][3], inf.source, step) } else { Vec3::ZERO };
+            st.wind = [w.x + air.x, w.y + air.y, w.z + air.z, reconfiguration(w, step)];
         }
     }
 }
+}
+
+/// Key of the leaves' streams of air ([`leaf_air`]).
+const LEAF_AIR_KEY: u32 = 0x1eaf_a1e5;
+
+/// The air's fluctuation at a leaf, m/s: the turbulence at the leaf's own scale, which the
+/// wind field does not resolve (its smallest eddies are crown-sized) and which makes
+/// leaves flutter (Tadrist et al. 2018). A narrow band at the leaf's swing `omega` (rad/s)
+/// with the leaves' damping ratio as its half-power width ([`crate::leaves::kernels::leaf_band`],
+/// unit RMS, phases from the leaf's index `source`), along a direction of its own, with RMS
+/// `σ = s |u| |u|² / (|u|² + u_o²)` (`s` = [`RawHsmStep::leaf_turbulence`], `u_o` =
+/// [`RawHsmStep::flutter_onset`]): zero in still air, rising from the onset on as the closed
+/// form's flutter does. The leaf cluster's spring and drag make the swing from it, at the
+/// cluster's own frequency and damping. WGSL: `hsm_leaf_air` in `hsm_cluster_stage.wgsl`.
+#[inline]
+pub fn leaf_air(u: Vec3, omega: f32, source: u32, step: &RawHsmStep) -> Vec3 {
+    let speed2 = u.length_squared();
+    if step.leaf_turbulence == 0.0 || speed2 == 0.0 || omega == 0.0 {
+        return Vec3::ZERO;
+    }
+    let sigma = step.leaf_turbulence * speed2.sqrt() * speed2 / (speed2 + step.flutter_onset * step.flutter_onset);
+    let seed = pcg_hash(LEAF_AIR_KEY ^ source.wrapping_mul(0x9e37_79b9));
+    let d = Vec3::new(hash_unit(seed ^ 0x0a11), hash_unit(seed ^ 0x0b22), hash_unit(seed ^ 0x0c33)) * 2.0 - 1.0;
+    let len = d.length();
+    if len == 0.0 {
+        return Vec3::ZERO;
+    }
+    d * (sigma * leaf_band(omega, step.leaf_zeta, step.time, seed) / len)
 }
 
 /// A particle's goal as a displacement from rest (xyz) and ᾱ (w): the mean over its
@@ -491,15 +523,26 @@ mod tests {
     }
 
     /// The cluster wind compiled for AVX2 (where the CPU has it) and for the baseline gives
-    /// the same bits, at random centres and times, on every wind preset; leaf clusters keep
-    /// zero wind; a segment's w is the drag's reconfiguration at its wind.
+    /// the same bits, at random centres and times, on every wind preset; w is the drag's
+    /// reconfiguration at the wind; a leaf cluster's wind is a segment's at the same centre
+    /// plus its band of air ([`leaf_air`]), which moves it wherever the wind blows.
     #[test]
     fn cluster_wind_is_the_same_at_every_level() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
         let info: Vec<RawHsmClusterInfo> = (0..300)
             .map(|i| RawHsmClusterInfo {
                 kind: if i % 7 == 3 { kind::LEAF } else { kind::SEGMENT },
+                source: i,
                 ..bytemuck::Zeroable::zeroed()
+            })
+            .collect();
+        let as_segments: Vec<RawHsmClusterInfo> =
+            info.iter().map(|i| RawHsmClusterInfo { kind: kind::SEGMENT, ..*i }).collect();
+        let clusters: Vec<RawHsmCluster> = (0..info.len())
+            .map(|_| {
+                let mut c: RawHsmCluster = bytemuck::Zeroable::zeroed();
+                c.aqq_inv[1][3] = rng.random_range(10.0..60.0);
+                c
             })
             .collect();
         for (name, _, _) in crate::wind::PRESETS {
@@ -522,26 +565,39 @@ mod tests {
                     time,
                     reconfiguration_speed: drag.reconfiguration_speed,
                     vogel_exponent: drag.vogel_exponent,
+                    leaf_turbulence: 0.2,
+                    flutter_onset: 3.0,
+                    leaf_zeta: 0.15,
                     ..bytemuck::Zeroable::zeroed()
                 };
-                let run = |level: Level| {
+                let run = |level: Level, info: &[RawHsmClusterInfo]| {
                     let mut s = state.clone();
-                    wind_chunk_at(level, &fields, &waves, &info, &step, &mut s);
+                    wind_chunk_at(level, &fields, &waves, info, &clusters, &step, &mut s);
                     s
                 };
-                let base = run(Level::Baseline);
-                for (i, s) in base.iter().enumerate() {
-                    let moving = s.wind[..3].iter().any(|&w| w != 0.0);
-                    assert_eq!(moving, info[i].kind != kind::LEAF, "{name}: cluster {i} wind {:?}", s.wind);
-                    if moving {
-                        // w is the reconfiguration at the wind's speed.
-                        let g = drag.reconfiguration(Vec3::from_slice(&s.wind[..3]).length());
-                        assert!((s.wind[3] - g).abs() <= 1e-6 * g, "{name}: cluster {i} w {} against {g}", s.wind[3]);
+                let base = run(Level::Baseline, &info);
+                let plain = run(Level::Baseline, &as_segments);
+                for (i, (s, p)) in base.iter().zip(&plain).enumerate() {
+                    let u = Vec3::from_slice(&p.wind[..3]);
+                    // w is the reconfiguration at the wind's speed.
+                    let g = drag.reconfiguration(u.length());
+                    assert!((s.wind[3] - g).abs() <= 1e-6 * g, "{name}: cluster {i} w {} against {g}", s.wind[3]);
+                    let air = Vec3::from_slice(&s.wind[..3]) - u;
+                    if info[i].kind == kind::LEAF {
+                        // The sum's rounding aside (a few ulps of the wind).
+                        let want = leaf_air(u, clusters[i].aqq_inv[1][3], i as u32, &step);
+                        assert!(
+                            (air - want).length() <= 1e-6 * (u.length() + 1.0),
+                            "{name}: leaf {i}: {air} against {want}"
+                        );
+                        assert_eq!(air != Vec3::ZERO, u != Vec3::ZERO, "{name}: leaf {i} in {u}: air {air}");
+                    } else {
+                        assert_eq!(air, Vec3::ZERO, "{name}: cluster {i}");
                     }
                 }
                 let bits =
                     |s: &[RawHsmClusterState]| s.iter().flat_map(|c| c.wind.map(f32::to_bits)).collect::<Vec<_>>();
-                assert_eq!(bits(&base), bits(&run(detected())), "{name} at t = {time}");
+                assert_eq!(bits(&base), bits(&run(detected(), &info)), "{name} at t = {time}");
             }
         }
     }

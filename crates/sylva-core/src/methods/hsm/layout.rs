@@ -24,8 +24,8 @@ pub struct HsmLayout {
     pub mass: Vec<f32>,
     /// 1 for a free particle, 0 for a fixed one.
     pub free: Vec<f32>,
-    /// The cluster whose wind each particle feels: the cluster that made it, or for a leaf
-    /// blade its segment's cluster (leaves are too small to sample the air apart).
+    /// The cluster whose wind each particle feels: the cluster that made it (a leaf blade's
+    /// is its leaf cluster, whose wind adds the air at the leaf's scale).
     pub owner: Vec<u32>,
     /// Start of each particle's run in `member` (one more entry than particles).
     pub member_offset: Vec<u32>,
@@ -199,6 +199,7 @@ impl HsmLayout {
                 slot_particles.extend(first..first + k as u32);
                 let lq = l.orientation[leaf];
                 let first_own = b.pos.len() as u32;
+                let leaf_cluster = b.layout.info.len() as u32;
                 for p in 0..n {
                     // The tip, then points along the edge toward the base.
                     let local = if p == 0 {
@@ -206,7 +207,7 @@ impl HsmLayout {
                     } else {
                         Vec3::new(0.5 * w, h * (1.0 - p as f32 / n as f32), 0.0)
                     };
-                    b.particle(l.position[leaf] + lq * local, m, kd, true, c);
+                    b.particle(l.position[leaf] + lq * local, m, kd, true, leaf_cluster);
                 }
                 slot_particles.extend(first_own..first_own + n as u32);
                 b.rings.push(vec![(centre, first)]);
@@ -314,27 +315,29 @@ impl HsmLayout {
             let (kk, mu) = stiffness[c];
             let mut kc = if mu > 0.0 { kk / (mu * (scale / msum) as f32).max(1e-30) } else { kk };
             if info.kind == kind::LEAF {
-                // The cluster's R turns with the blade by the blade's share `f` of its
-                // moment of inertia, so the blade's spring pulls on `1 − f` of its turn: the
-                // rate `ω² / (1 − f)` swings it at the petiole's ω (`1 − f` at least 0.05).
-                let blade = (info.slot_count - params.leaf_particles) as usize;
-                let j = |ps: &[u32]| -> f64 {
-                    ps.iter()
-                        .map(|&p| {
-                            b.layout.mass[p as usize] as f64 * (b.pos[p as usize].as_dvec3() - cm).length_squared()
-                        })
-                        .sum()
-                };
-                let (jr, jb) = (j(&run[..blade]), j(&run[blade..]));
-                kc /= ((jr / (jr + jb).max(1e-30)) as f32).max(0.05);
+                // The blade pulls its cluster's centre and R along as it swings, so its
+                // spring holds only a fraction ρ of the swing: the rate ω² / ρ swings it at
+                // the petiole's ω (ρ at least 0.02; see `swing_fraction`).
+                let ring = (info.slot_count - params.leaf_particles) as usize;
+                let leaf = info.source as usize;
+                let pitch = (l.orientation[leaf] * Vec3::X).as_dvec3();
+                let at = |p: u32| (b.pos[p as usize].as_dvec3(), b.layout.mass[p as usize] as f64);
+                let rho = swing_fraction(run.iter().map(|&p| at(p)), ring, l.position[leaf].as_dvec3(), pitch, aqq);
+                kc /= (rho as f32).max(0.02);
             }
+            // A leaf's swing ω (its rate before the share above), the centre of its band of air.
+            let omega = if info.kind == kind::LEAF { kk.max(0.0).sqrt() } else { 0.0 };
             clusters.push(RawHsmCluster {
                 rest_cm: [cmf.x, cmf.y, cmf.z, kc],
                 parent: parents[c],
                 child_offset: child_offset[c],
                 child_count: child_count[c],
                 mass: msum as f32,
-                aqq_inv: [inv.x_axis.extend(0.0).into(), inv.y_axis.extend(0.0).into(), inv.z_axis.extend(0.0).into()],
+                aqq_inv: [
+                    inv.x_axis.extend(0.0).into(),
+                    inv.y_axis.extend(omega).into(),
+                    inv.z_axis.extend(0.0).into(),
+                ],
             });
         }
         path_bounds(&mut clusters);
@@ -458,4 +461,39 @@ fn path_bounds(clusters: &mut [RawHsmCluster]) {
         let own = clusters[c].rest_cm[3];
         clusters[c].aqq_inv[0][3] = if p == NONE { own } else { own.min(clusters[p as usize].aqq_inv[0][3]) };
     }
+}
+
+/// The fraction of a leaf blade's swing that its cluster's spring holds: shape matching
+/// linearised about rest. The blade's particles (after the first `ring` of `particles`,
+/// position and mass) turn by a small angle about `axis` through the attachment `attach`;
+/// the ring stays (its segment holds it). The cluster's centre moves by the blade's share of
+/// the mass, `Δc`, and its R by the Newton step of the optimal rotation at rest,
+/// `θ = (tr(A) I − A)⁻¹ Σ m q × (u − Δc)` (`A` = `aqq`, Σ m q qᵀ), so each particle's goal
+/// moves by `θ × q + Δc`. The spring's pull on the blade, `Σ m (u − g)·s`, over its inertia
+/// in the swing, `Σ m |s|²` (`s = axis × (x − attach)`, `u = s` per unit angle), is the
+/// fraction ρ: the blade swings at `√(k ρ)` under rate `k`. 1 when the ring is rigid and
+/// heavy; small when the blade carries most of the cluster's mass.
+pub fn swing_fraction(
+    particles: impl Iterator<Item = (DVec3, f64)>,
+    ring: usize,
+    attach: DVec3,
+    axis: DVec3,
+    aqq: DMat3,
+) -> f64 {
+    let parts: Vec<(DVec3, f64)> = particles.collect();
+    let mass: f64 = parts.iter().map(|p| p.1).sum();
+    let cm = parts.iter().map(|p| p.0 * p.1).sum::<DVec3>() / mass.max(1e-300);
+    let swing = |i: usize, x: DVec3| if i < ring { DVec3::ZERO } else { axis.cross(x - attach) };
+    let shift = parts.iter().enumerate().map(|(i, p)| swing(i, p.0) * p.1).sum::<DVec3>() / mass.max(1e-300);
+    let torque: DVec3 = parts.iter().enumerate().map(|(i, p)| (p.0 - cm).cross(swing(i, p.0) - shift) * p.1).sum();
+    let h = DMat3::from_diagonal(DVec3::splat(aqq.x_axis.x + aqq.y_axis.y + aqq.z_axis.z)) - aqq;
+    let theta = if h.determinant().abs() > 1e-300 { h.inverse() * torque } else { DVec3::ZERO };
+    let (mut pull, mut inertia) = (0.0, 0.0);
+    for (i, p) in parts.iter().enumerate().skip(ring) {
+        let s = swing(i, p.0);
+        let goal = theta.cross(p.0 - cm) + shift;
+        pull += (s - goal).dot(s) * p.1;
+        inertia += s.length_squared() * p.1;
+    }
+    if inertia > 0.0 { (pull / inertia).clamp(0.0, 1.0) } else { 1.0 }
 }

@@ -11,10 +11,12 @@
 //! * A **leaf cluster** is the nearest ring of its segment's cluster (shared) plus
 //!   `leaf_particles` points on the blade (its tip, then points along an edge). Its rate is
 //!   its petiole's swing `ω²`, the closed form's ([`crate::leaves::leaf_constants`]: from
-//!   the blade and the species' `[leaf_motion]`, above its twig's mode), over `1 − f`, `f`
-//!   the blade's share of the cluster's moment of inertia (R turns with the blade by about
-//!   `f`, so its spring pulls on the rest), so a leaf swings near the same frequency in
-//!   every method. The pose seam's leaf rotation is where the blade
+//!   the blade and the species' `[leaf_motion]`, above its twig's mode), over the fraction
+//!   of a swing its spring holds ([`layout::swing_fraction`]: the blade drags the cluster's
+//!   centre and R along), so a leaf swings near the same frequency in every method. Its
+//!   blade feels the wind at the cluster's centre plus the air at the leaf's own scale, a
+//!   narrow band about ω ([`kernels::leaf_air`], [`HsmParams::leaf_turbulence`]): that is
+//!   what makes it flutter. The pose seam's leaf rotation is where the blade
 //!   points: [`kernels::hsm_leaf_pose`] reads the tip and edge particles in the cluster's
 //!   frame.
 //! * Particles are the simulation's proxies, not the bark: a ring's radius is the segment's
@@ -49,7 +51,7 @@
 //! 4. `hsm_integrate` (per particle): `v += ᾱ (ĝ − x) / h + h g` with
 //!    `ᾱ = min(Σ w_c, hold)` (see "Stiffness" below; Table 1 steps 5–6; a
 //!    prestressed tree's support cancels g, see [`HsmParams::prestressed`]),
-//!    drag toward the wind `u` sampled at its cluster's centre (a leaf's segment's)
+//!    drag toward the wind `u` sampled at its cluster's centre (a leaf's with its band of air)
 //!    `v += (u − v) s / (1 + s)`,
 //!    `s = h k_d g(|u|) |u − v|` (semi-implicit, so it never overshoots the air; `g` Vogel's
 //!    reconfiguration at the cluster's wind, [`kernels::reconfiguration`], as every method
@@ -182,6 +184,8 @@ pub struct Hsm {
     pub leaf_cluster: Vec<u32>,
     /// Each leaf's blade in the particles, for [`kernels::hsm_leaf_pose`].
     pub leaves: Vec<RawHsmLeaf>,
+    /// The tree's leaf motion: the onset, band width and crown share of the leaves' air.
+    pub leaf_motion: crate::leaves::LeafMotion,
 }
 
 impl Hsm {
@@ -248,7 +252,7 @@ impl Hsm {
                 }
             }
         }
-        Self { params, layout, runs, groups, rest_joints, leaf_cluster, leaves }
+        Self { params, layout, runs, groups, rest_joints, leaf_cluster, leaves, leaf_motion: tree.leaf_motion }
     }
 
     /// The state at rest (without prestress, gravity has yet to sag it: see [`Self::settle`]).
@@ -301,7 +305,9 @@ impl Hsm {
             vogel_exponent: p.vogel_exponent,
             air: if p.drag_scale > 0.0 { p.air_damping / p.drag_scale } else { 1.0 },
             sample_wind: 1,
-            _pad: [0; 3],
+            leaf_turbulence: p.leaf_turbulence * self.leaf_motion.crown_wind,
+            flutter_onset: self.leaf_motion.flutter_onset / self.leaf_motion.crown_wind.max(f32::MIN_POSITIVE),
+            leaf_zeta: self.leaf_motion.damping_ratio,
         }
     }
 

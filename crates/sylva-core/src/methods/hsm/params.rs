@@ -41,6 +41,14 @@ pub struct HsmParams {
     /// closed form's [`crate::leaves::leaf_constants`], from the blade and the species'
     /// `[leaf_motion]`, above its twig's mode) times this. Default 1.
     pub leaf_stiffness: f32,
+    /// RMS of the air's velocity at a leaf's scale and in its band, as a fraction of the
+    /// wind the leaf feels inside the crown ([`crate::leaves::LeafMotion::crown_wind`] of the
+    /// wind at its centre), well above the flutter onset
+    /// ([`crate::leaves::LeafMotion::flutter_onset`]); see [`super::kernels::leaf_air`].
+    /// Default 0.3: canopy turbulence intensities are 0.3–0.6 (Finnigan 2000), and 0.3 makes
+    /// HSM's leaves flutter about as much as the closed form's in `gusty` (`leaf_motion`
+    /// tests). 0: leaves move only with the resolved wind.
+    pub leaf_turbulence: f32,
     /// Structural damping ratio ζ of the trunk's first mode: velocities are damped at the
     /// rate `c = 2 ζ ω₀` (`v *= e^{−c h}` each substep), ω₀ the trunk's frequency from the
     /// wood ([`crate::physics::stem_frequencies`]), so the ratio holds at any step. The
@@ -138,6 +146,7 @@ impl Default for HsmParams {
             stiffness_scale: 1.0,
             min_radius: 0.0015,
             leaf_stiffness: 1.0,
+            leaf_turbulence: 0.3,
             damping_ratio: crate::physics::STRUCTURAL_DAMPING,
             drag: 0.8,
             leaf_drag: 0.05,
@@ -223,6 +232,9 @@ impl HsmParams {
         }
         if !(self.min_radius.is_finite() && self.min_radius >= 0.0) {
             return bad("min_radius", self.min_radius, "expected a finite number ≥ 0 (m)");
+        }
+        if !(self.leaf_turbulence.is_finite() && (0.0..=10.0).contains(&self.leaf_turbulence)) {
+            return bad("leaf_turbulence", self.leaf_turbulence, "expected 0 to 10");
         }
         if !(self.damping_ratio.is_finite() && (0.0..=10.0).contains(&self.damping_ratio)) {
             return bad("damping_ratio", self.damping_ratio, "expected 0 to 10");

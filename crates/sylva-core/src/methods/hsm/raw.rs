@@ -43,7 +43,9 @@ pub struct RawHsmCluster {
     pub mass: f32,
     /// Columns of Aqq⁻¹ (xyz; zero where Aqq is singular), 1/(kg·m²). The first column's w
     /// is the rate bound k̂, 1/s²: the smallest k on the path from the root to this cluster
-    /// (see [`crate::methods::hsm::kernels::MAX_WEIGHT`]); the other two are zero.
+    /// (see [`crate::methods::hsm::kernels::MAX_WEIGHT`]). The second's is a leaf cluster's
+    /// swing ω, rad/s, the centre of the band of air it feels (see
+    /// [`crate::methods::hsm::kernels::leaf_air`]); zero for other clusters. The third's is zero.
     pub aqq_inv: [[f32; 4]; 3],
 }
 
@@ -80,9 +82,9 @@ pub struct RawHsmClusterState {
     /// Columns of the goal transform T (xyz); the w components are the centre's shift
     /// from rest `c − c⁰` (x, y, z), which goals are built from.
     pub transform: [[f32; 4]; 3],
-    /// Wind velocity at the centre of mass (xyz), m/s; w = the drag's reconfiguration factor
-    /// there ([`super::kernels::reconfiguration`]; 1 for a leaf cluster, whose particles feel
-    /// their segment's).
+    /// Wind velocity at the centre of mass (xyz), m/s, plus for a leaf cluster the air's
+    /// fluctuation in its band ([`super::kernels::leaf_air`]); w = the drag's
+    /// reconfiguration factor at the wind ([`super::kernels::reconfiguration`]).
     pub wind: [f32; 4],
 }
 
@@ -131,10 +133,19 @@ pub struct RawHsmStep {
     /// The drag's relative velocity is `wind − air · v`: [`super::HsmParams::air_damping`]
     /// over [`super::HsmParams::drag_scale`] (1 when the drag scale is 0).
     pub air: f32,
-    /// 1: stage 1 samples the wind at the segment clusters' centres (the first substep of
-    /// a step); 0: the clusters keep the wind they hold (see [`super::Hsm::step_packed`]).
+    /// 1: stage 1 samples the wind at the clusters' centres (the first substep of a step);
+    /// 0: the clusters keep the wind they hold (see [`super::Hsm::step_packed`]).
     pub sample_wind: u32,
-    pub _pad: [u32; 3],
+    /// RMS of the air's velocity in a leaf's band, as a fraction of the wind at the leaf's
+    /// centre well above the onset: [`super::HsmParams::leaf_turbulence`] times the crown's
+    /// share of the wind ([`crate::leaves::LeafMotion::crown_wind`]).
+    pub leaf_turbulence: f32,
+    /// Wind at a leaf's centre at which that air reaches half its RMS, m/s:
+    /// [`crate::leaves::LeafMotion::flutter_onset`] over the crown's share.
+    pub flutter_onset: f32,
+    /// Half-power width of the leaves' band, the damping ratio of their swing
+    /// ([`crate::leaves::LeafMotion::damping_ratio`]).
+    pub leaf_zeta: f32,
 }
 
 /// [`super::HsmState::velocity`]'s w for a fixed particle (free ones carry their drag factor ≥ 0).

@@ -68,7 +68,9 @@ struct HsmStep {
     vogel_exponent: f32,
     air: f32,
     sample_wind: u32,
-    _pad: array<u32, 3>,
+    leaf_turbulence: f32,
+    flutter_onset: f32,
+    leaf_zeta: f32,
 }
 
 // Vogel's reconfiguration of a cluster's drag in the wind `u` at its centre, (1 + r²)^(B/2)

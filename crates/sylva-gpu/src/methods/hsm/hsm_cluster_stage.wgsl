@@ -3,7 +3,7 @@
 // strides over the slots), the kernel adds the 64 lanes by a tree (`hsm_clusters`: in shared
 // memory; `hsm_clusters_subgroup`: in shared memory down to the subgroup, then by shuffles,
 // the same additions in the same order), then one invocation extracts R, forms the goal
-// transform, α and the wind (`hsm_finish_cluster`). CPU twin:
+// transform, α and the wind, a leaf's with its band of air (`hsm_finish_cluster`). CPU twin:
 // sylva_core::methods::hsm::kernels::hsm_clusters (same lanes, same reduction tree).
 // Bindings: 0 fields, 1 waves, 2 cluster info, 3 clusters, 4 slots, 5 displacements from
 // rest (w = mass), 6 step, 7 cluster state.
@@ -109,10 +109,29 @@ fn hsm_finish_cluster(c: u32, sp: vec3<f32>, sums: HsmSums) {
     );
     // The wind is sampled on a step's first substep and held through the others.
     if (step.sample_wind != 0u) {
-        var u = vec3<f32>(0.0);
-        if (inf.kind != HSM_LEAF) {
-            u = wind_at(cm, step.time);
+        let u = wind_at(cm, step.time);
+        var air = vec3<f32>(0.0);
+        if (inf.kind == HSM_LEAF) {
+            air = hsm_leaf_air(u, cl.aqq_inv[1].w, inf.source);
         }
-        state[c].wind = vec4<f32>(u, hsm_reconfiguration(u, step));
+        state[c].wind = vec4<f32>(u + air, hsm_reconfiguration(u, step));
     }
 }
+
+// The air's fluctuation at a leaf in its band (see the CPU twin, kernels::leaf_air).
+fn hsm_leaf_air(u: vec3<f32>, omega: f32, source: u32) -> vec3<f32> {
+    let speed2 = dot(u, u);
+    if (step.leaf_turbulence == 0.0 || speed2 == 0.0 || omega == 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let sigma = step.leaf_turbulence * sqrt(speed2) * speed2 / (speed2 + step.flutter_onset * step.flutter_onset);
+    let seed = pcg_hash(HSM_LEAF_AIR_KEY ^ (source * 0x9e3779b9u));
+    let d = vec3<f32>(hash_unit(seed ^ 0x0a11u), hash_unit(seed ^ 0x0b22u), hash_unit(seed ^ 0x0c33u)) * 2.0 - 1.0;
+    let len = length(d);
+    if (len == 0.0) {
+        return vec3<f32>(0.0);
+    }
+    return d * (sigma * leaf_band(omega, step.leaf_zeta, step.time, seed) / len);
+}
+
+const HSM_LEAF_AIR_KEY: u32 = 0x1eafa1e5u;
