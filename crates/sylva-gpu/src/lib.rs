@@ -25,6 +25,7 @@ pub mod methods;
 pub mod pose;
 pub mod render;
 pub mod shaders;
+pub mod step_slots;
 pub mod timer;
 pub mod wind;
 

@@ -13,7 +13,7 @@ use sylva_core::species::SpeciesSource;
 use sylva_core::wind::WindScene;
 use sylva_gpu::methods::GpuAnimator;
 use sylva_gpu::methods::hsm::{GpuHsm, SUBSTEPS_PER_PASS};
-use sylva_gpu::methods::skjermo::GpuSkjermo;
+use sylva_gpu::methods::skjermo::{GpuSkjermo, STEPS_PER_PASS};
 use sylva_gpu::methods::zioma::GpuZioma;
 use sylva_gpu::wind::GpuWind;
 use sylva_gpu::{GpuContext, GpuCounts};
@@ -61,16 +61,22 @@ fn steps_record_their_dispatches_in_one_pass_on_bind_groups_made_once() {
     let c = counted(ctx, || g.advance_steps(ctx, dt, 2));
     assert_eq!(c.bind_groups, 2 * per_pass, "stage 1 and the particle pass bound to the new wind: {c:?}");
 
-    // Skjermo: a frame's steps in one submission, one dispatch each, the pose once.
+    // Skjermo: a frame's steps in one submission, one dispatch each, up to STEPS_PER_PASS
+    // of them in one pass (each reading its own slot of parameters), the pose once; every
+    // slot's two steps (from either state buffer) bound on first use.
     let m = Skjermo::new(&tree, SkjermoParams::default());
     let mut g = GpuSkjermo::new(ctx, tree.clone(), &m, &gpu_wind).unwrap();
-    counted(ctx, || g.advance_steps(ctx, dt, 1, true));
+    let first = counted(ctx, || g.advance_steps(ctx, dt, 1, true));
+    assert!(first.bind_groups >= 2 * STEPS_PER_PASS as u64, "{first:?}");
     let one = counted(ctx, || g.advance_steps(ctx, dt, 1, true));
     let five = counted(ctx, || g.advance_steps(ctx, dt, 5, true));
-    assert_eq!((one.submissions, five.submissions), (1, 1), "{one:?} {five:?}");
+    let more = counted(ctx, || g.advance_steps(ctx, dt, STEPS_PER_PASS + 1, true));
+    assert_eq!((one.submissions, five.submissions, more.submissions), (1, 1, 1), "{one:?} {five:?}");
     assert_eq!(five.dispatches, one.dispatches + 4, "one dispatch per further step: {one:?} {five:?}");
-    assert_eq!((one.bind_groups, five.bind_groups), (0, 0), "{one:?} {five:?}");
-    println!("Skjermo, one step: {one:?}; five steps: {five:?}");
+    assert_eq!(five.passes, one.passes, "five steps in the pass of one: {one:?} {five:?}");
+    assert_eq!(more.passes, one.passes + 1, "a pass per {STEPS_PER_PASS} steps: {one:?} {more:?}");
+    assert_eq!((one.bind_groups, five.bind_groups, more.bind_groups), (0, 0, 0), "{one:?} {five:?} {more:?}");
+    println!("Skjermo, one step: {one:?}; five steps: {five:?}; {} steps: {more:?}", STEPS_PER_PASS + 1);
 
     // Zioma: the rotations, the pose and the leaves each in one pass on bind groups made
     // once; meshing the pose is one pass, and binds again only for other pose buffers.

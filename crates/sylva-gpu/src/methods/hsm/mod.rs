@@ -7,13 +7,15 @@
 //! reduction; stage 2, the synchronisation, is the boundary between dispatches; stage 3
 //! `hsm_goals` and stage 4 `hsm_integrate` run one invocation per particle, or fused as
 //! `hsm_particles` ([`sylva_core::methods::hsm::HsmParams::fused`]). Each substep's
-//! parameters (its time) are copied into the step buffer by a copy command between
-//! substeps, so one submission carries every substep; a substep's dispatches share one
-//! compute pass and bind groups made once.
+//! parameters (its time) are written once per submission and copied, up to
+//! [`SUBSTEPS_PER_PASS`] at a time, into as many slots ([`StepSlots`]): one submission
+//! carries every substep, up to 64 substeps share a compute pass, and their bind groups are
+//! made once.
 
 use super::{BuildError, GpuAnimator};
 use crate::kernel::{Kernel, Plan, compute_pass, output, upload};
 use crate::pose::GpuPose;
+use crate::step_slots::StepSlots;
 use crate::wind::GpuWind;
 use crate::{GpuContext, GpuError};
 use glam::Vec3;
@@ -45,15 +47,8 @@ pub struct GpuHsm {
     segment_cluster: wgpu::Buffer,
     leaf_pose_kernel: Arc<Kernel>,
     leaves: wgpu::Buffer,
-    /// The substep parameters of the current submission, one per `step_stride` bytes.
-    steps: wgpu::Buffer,
-    steps_capacity: usize,
-    /// [`SUBSTEPS_PER_PASS`] substeps' parameters, copied from `steps` before each pass;
-    /// substep k of a pass reads slot k.
-    step_slots: wgpu::Buffer,
-    /// Bytes from one slot to the next: a substep's parameters, rounded up to the device's
-    /// storage-binding offset alignment.
-    step_stride: u64,
+    /// [`SUBSTEPS_PER_PASS`] slots of substep parameters: substep k of a pass reads slot k.
+    steps: StepSlots<RawHsmStep>,
     displacement: wgpu::Buffer,
     velocity: wgpu::Buffer,
     state: wgpu::Buffer,
@@ -64,7 +59,7 @@ pub struct GpuHsm {
     pose_plan: Plan,
     leaf_plan: Plan,
     /// A substep's dispatches (stage 1, then the fused particle pass or stages 3 and 4), one
-    /// plan per slot of `step_slots`, all bound on first use after the wind is set.
+    /// plan per slot of `steps`, all bound on first use after the wind is set.
     substep: Option<Vec<Plan>>,
     /// Simulated time, s.
     pub time: f32,
@@ -94,8 +89,6 @@ impl GpuHsm {
             None => None,
         };
         let step = method.step_params(0.0, 0.0);
-        let align = ctx.device.limits().min_storage_buffer_offset_alignment as u64;
-        let stride = (std::mem::size_of::<RawHsmStep>() as u64).div_ceil(align) * align;
         let mut this = Self {
             clusters_kernel: clusters_kernel(ctx, true),
             goals_kernel: Kernel::get(ctx, "hsm_goals"),
@@ -114,10 +107,7 @@ impl GpuHsm {
             segment_cluster: upload(ctx, "hsm segment clusters", &l.segment_cluster)?,
             leaf_pose_kernel: Kernel::get(ctx, "hsm_leaf_pose"),
             leaves: upload(ctx, "hsm leaves", &method.leaves)?,
-            steps: step_buffer(ctx, "hsm substeps", stride, SUBSTEPS_PER_PASS),
-            steps_capacity: SUBSTEPS_PER_PASS,
-            step_slots: upload(ctx, "hsm step slots", &slots(&vec![step; SUBSTEPS_PER_PASS], stride))?,
-            step_stride: stride,
+            steps: StepSlots::new(ctx, "hsm substeps", SUBSTEPS_PER_PASS, step)?,
             displacement: upload(ctx, "hsm displacements", &rest_state.displacement)?,
             velocity: upload(ctx, "hsm velocities", &rest_state.velocity)?,
             state: upload(ctx, "hsm cluster state", &rest_state.clusters)?,
@@ -192,12 +182,7 @@ impl GpuHsm {
                     RawHsmStep { sample_wind: (k % n == 0) as u32, ..method.step_params(self.time, h) }
                 })
                 .collect();
-            let stride = self.step_stride;
-            if batch > self.steps_capacity {
-                self.steps = step_buffer(ctx, "hsm substeps", stride, batch);
-                self.steps_capacity = batch;
-            }
-            ctx.queue.write_buffer(&self.steps, 0, &slots(&params, stride));
+            self.steps.write(ctx, &params);
             let mut e = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hsm") });
             let plans = match self.substep.take() {
                 Some(p) => p,
@@ -205,7 +190,7 @@ impl GpuHsm {
             };
             for first in (0..batch).step_by(SUBSTEPS_PER_PASS) {
                 let count = (batch - first).min(SUBSTEPS_PER_PASS);
-                e.copy_buffer_to_buffer(&self.steps, first as u64 * stride, &self.step_slots, 0, count as u64 * stride);
+                self.steps.copy(&mut e, first, count);
                 let mut pass = compute_pass(ctx, &mut e, "hsm substeps");
                 for plan in &plans[..count] {
                     plan.dispatch(ctx, &mut pass);
@@ -220,14 +205,10 @@ impl GpuHsm {
         }
     }
 
-    /// The dispatches of the substep that reads slot `slot` of `step_slots`.
+    /// The dispatches of the substep that reads slot `slot` of `steps`.
     fn plan_substep(&self, ctx: &GpuContext, slot: usize) -> Plan {
         let lanes = sylva_core::methods::hsm::kernels::LANES as u32;
-        let step = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-            buffer: &self.step_slots,
-            offset: slot as u64 * self.step_stride,
-            size: std::num::NonZeroU64::new(std::mem::size_of::<RawHsmStep>() as u64),
-        });
+        let step = self.steps.binding(slot);
         fn all(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
             b.as_entire_binding()
         }
@@ -373,25 +354,4 @@ impl GpuAnimator for GpuHsm {
     fn particles(&self) -> Option<usize> {
         Some(self.n_particles)
     }
-}
-
-/// `params` laid out one per `stride` bytes (the gaps zero).
-fn slots(params: &[RawHsmStep], stride: u64) -> Vec<u8> {
-    let size = std::mem::size_of::<RawHsmStep>();
-    let mut bytes = vec![0u8; params.len() * stride as usize];
-    for (chunk, p) in bytes.chunks_exact_mut(stride as usize).zip(params) {
-        chunk[..size].copy_from_slice(bytemuck::bytes_of(p));
-    }
-    bytes
-}
-
-/// A buffer for `count` substeps' parameters at `stride` bytes, filled by writes and read
-/// by copies.
-fn step_buffer(ctx: &GpuContext, label: &'static str, stride: u64, count: usize) -> wgpu::Buffer {
-    ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: stride * count as u64,
-        usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
 }

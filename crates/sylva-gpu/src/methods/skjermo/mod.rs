@@ -1,12 +1,14 @@
-//! Skjermo's method on the GPU: the steps (ping-pong state buffers, each step's time copied
-//! into the step buffer between dispatches), then the seam rotations and forward kinematics,
-//! all in one submission however many steps a frame advances; the curves stay on the device
-//! for the deformer.
+//! Skjermo's method on the GPU: the steps (ping-pong state buffers; up to
+//! [`STEPS_PER_PASS`] steps in one compute pass, each reading its parameters from its own
+//! slot, [`StepSlots`]), then the seam rotations and forward kinematics, all in one
+//! submission however many steps a frame advances; the curves stay on the device for the
+//! deformer.
 
 use super::{BuildError, GpuAnimator, GpuCurves};
-use crate::kernel::{Kernel, Plan, output, read_back, upload};
+use crate::kernel::{Kernel, Plan, compute_pass, output, read_back, upload};
 use crate::leaves::GpuLeafFlutter;
 use crate::pose::GpuPose;
+use crate::step_slots::StepSlots;
 use crate::wind::GpuWind;
 use crate::{GpuContext, GpuError};
 use bytemuck::Zeroable;
@@ -27,12 +29,11 @@ pub struct GpuSkjermo {
     wind: GpuWind,
     stems: wgpu::Buffer,
     params: wgpu::Buffer,
-    step: wgpu::Buffer,
-    /// The step parameters of the current submission, one after another.
-    steps: wgpu::Buffer,
-    steps_capacity: usize,
-    /// The step from state 0 to 1 and from 1 to 0, bound on first use after the wind is set.
-    plans: Option<[Plan; 2]>,
+    /// [`STEPS_PER_PASS`] slots of step parameters: step k of a pass reads slot k.
+    steps: StepSlots<RawSkjermoStep>,
+    /// Per slot, the step from state 0 to 1 and from 1 to 0, bound on first use after the
+    /// wind is set.
+    plans: Option<Vec<[Plan; 2]>>,
     /// The seam's rotations from state 0 and from state 1.
     rotation_plans: [Plan; 2],
     state: [wgpu::Buffer; 2],
@@ -75,9 +76,7 @@ impl GpuSkjermo {
             wind: wind.clone(),
             stems: stems_buffer,
             params: upload(ctx, "segment params", &method.segment_param)?,
-            step: upload(ctx, "skjermo step", &[method.step_params(0.0)])?,
-            steps: upload(ctx, "skjermo steps", &[method.step_params(0.0)])?,
-            steps_capacity: 1,
+            steps: StepSlots::new(ctx, "skjermo steps", STEPS_PER_PASS, method.step_params(0.0))?,
             plans: None,
             state: [upload(ctx, "skjermo state a", &rest)?, upload(ctx, "skjermo state b", &rest)?],
             current: 0,
@@ -140,10 +139,11 @@ impl GpuSkjermo {
         self.advance_steps(ctx, dt, 1, false);
     }
 
-    /// Advances by `steps` steps of `dt` seconds in one submission (not waited for): each
-    /// step's parameters are copied into the step buffer before its dispatch, the state
-    /// buffers ping-pong, and with `with_pose` the seam's rotations, forward kinematics and
-    /// leaves are written once, for the last step (the same pose as stepping one by one).
+    /// Advances by `steps` steps of `dt` seconds in one submission (not waited for): the
+    /// steps' parameters are written once and copied, [`STEPS_PER_PASS`] at a time, into the
+    /// slots that the steps of a pass read; the state buffers ping-pong; and with `with_pose`
+    /// the seam's rotations, forward kinematics and leaves are written once, for the last
+    /// step (the same pose as stepping one by one).
     pub fn advance_steps(&mut self, ctx: &GpuContext, dt: f32, steps: usize, with_pose: bool) {
         if steps == 0 {
             return;
@@ -155,40 +155,22 @@ impl GpuSkjermo {
                 RawSkjermoStep { time: self.time, dt, ..self.method_step }
             })
             .collect();
-        if steps > self.steps_capacity {
-            self.steps = output::<RawSkjermoStep>(ctx, "skjermo steps", steps).expect("step parameters fit");
-            self.steps_capacity = steps;
-        }
-        ctx.queue.write_buffer(&self.steps, 0, bytemuck::cast_slice(&params));
-        let n = self.rest.len() as u32;
-        let plans = self.plans.get_or_insert_with(|| {
-            [0, 1].map(|from| {
-                let mut plan = Plan::default();
-                plan.push(
-                    ctx,
-                    &self.step_kernel,
-                    &[
-                        &self.wind.fields,
-                        &self.wind.waves,
-                        &self.stems,
-                        &self.state[from],
-                        &self.step,
-                        &self.state[1 - from],
-                        &self.modes,
-                        &self.sway,
-                    ],
-                    n,
-                );
-                plan
-            })
-        });
-        let size = std::mem::size_of::<RawSkjermoStep>() as u64;
+        self.steps.write(ctx, &params);
+        let plans = match self.plans.take() {
+            Some(p) => p,
+            None => (0..STEPS_PER_PASS).map(|slot| [0, 1].map(|from| self.plan_step(ctx, slot, from))).collect(),
+        };
         let mut e = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("skjermo") });
-        for k in 0..steps {
-            e.copy_buffer_to_buffer(&self.steps, k as u64 * size, &self.step, 0, size);
-            plans[self.current].record(ctx, &mut e, "skjermo step");
-            self.current = 1 - self.current;
+        for first in (0..steps).step_by(STEPS_PER_PASS) {
+            let count = (steps - first).min(STEPS_PER_PASS);
+            self.steps.copy(&mut e, first, count);
+            let mut pass = compute_pass(ctx, &mut e, "skjermo steps");
+            for slot in &plans[..count] {
+                slot[self.current].dispatch(ctx, &mut pass);
+                self.current = 1 - self.current;
+            }
         }
+        self.plans = Some(plans);
         if with_pose {
             let pose = &self.pose;
             self.rotation_plans[self.current].record(ctx, &mut e, "skjermo rotations");
@@ -196,6 +178,26 @@ impl GpuSkjermo {
             self.leaves.record_pose(ctx, &mut e, &self.wind, pose, self.time);
         }
         ctx.submit([e.finish()]);
+    }
+
+    /// The step from state `from` to the other, reading its parameters from slot `slot`.
+    fn plan_step(&self, ctx: &GpuContext, slot: usize, from: usize) -> Plan {
+        fn all(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+            b.as_entire_binding()
+        }
+        let resources = [
+            all(&self.wind.fields),
+            all(&self.wind.waves),
+            all(&self.stems),
+            all(&self.state[from]),
+            self.steps.binding(slot),
+            all(&self.state[1 - from]),
+            all(&self.modes),
+            all(&self.sway),
+        ];
+        let mut plan = Plan::default();
+        plan.push_resources(ctx, &self.step_kernel, &resources, self.rest.len() as u32);
+        plan
     }
 
     /// Reads the current pose back, with the animated Béziers (waits for the GPU).
@@ -212,6 +214,10 @@ impl GpuSkjermo {
         Ok(pose)
     }
 }
+
+/// Steps recorded into one compute pass: their parameters are copied into that many slots
+/// once before the pass, rather than one copy and one pass per step.
+pub const STEPS_PER_PASS: usize = 64;
 
 /// The registry's GPU constructor: Skjermo's method on `tree` (its copies share it).
 pub fn animator(
