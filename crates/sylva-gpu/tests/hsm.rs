@@ -178,8 +178,10 @@ fn hsm_subgroup_reduction_gives_the_shared_memory_bits() {
     println!("clusters wider than a subgroup of {size} in {wide:?}");
 }
 
-/// Whole trees (every cluster), calibrated to their wood, for 30 steps at a 240 Hz substep
-/// rate: within 1e-4 × tree height. The calibration softens some trees (a hold under 1) and
+/// Whole trees (every cluster), calibrated to their wood, for 12 steps (0.2 s) at a 240 Hz
+/// substep rate: within 1e-4 × tree height. (Drift over long runs is
+/// `hsm_matches_after_1000_steps_on_every_preset`'s, on truncated trees: lavapipe runs a
+/// whole aspen's substep in a good fraction of a second.) The calibration softens some trees (a hold under 1) and
 /// stiffens others (more substeps); both kinds are among them.
 #[test]
 fn hsm_whole_trees_match_on_the_gpu() {
@@ -196,7 +198,7 @@ fn hsm_whole_trees_match_on_the_gpu() {
         let mut gpu =
             GpuHsm::new(ctx, Some(Arc::new(t.clone())), Arc::new(h.clone()), &GpuWind::from_scene(ctx, &wind).unwrap())
                 .unwrap();
-        for _ in 0..30 {
+        for _ in 0..12 {
             h.step_packed(&fw.fields, &fw.waves, &mut cpu, 1.0 / 60.0);
             gpu.step(ctx, 1.0 / 60.0);
         }
