@@ -113,6 +113,11 @@ impl F32x16 {
     pub fn cmp_gt(self, o: Self) -> Self {
         self.mask(o, |a, b| a > b)
     }
+    /// Mask of `self == o`.
+    #[inline(always)]
+    pub fn cmp_eq(self, o: Self) -> Self {
+        self.mask(o, |a, b| a == b)
+    }
     /// Mask of the finite lanes.
     #[inline(always)]
     pub fn is_finite(self) -> Self {

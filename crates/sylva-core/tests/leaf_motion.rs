@@ -62,9 +62,11 @@ fn median(v: &[f32]) -> f32 {
 /// the turn's angle, a magnitude: a flutter about the rest shows at twice its frequency. Zioma, Akagi
 /// and Skjermo flutter by the closed form, every probed leaf above its segment. HSM's leaves
 /// are its leaf clusters, swinging at their petioles' frequency in the air at their own
-/// scale (`leaf_air`): their median peak lies above the segments', and at least five in six
-/// each above their own segment's (the others' twigs ring with the leaves they carry: a
-/// leaf cluster pulls on the ring it shares with its segment).
+/// scale (`leaf_air`): their median peak lies above the segments', and at least two in three
+/// each above their own segment's. The others: a twig's own clusters ring at 10–20 Hz, at or
+/// above the 12 Hz that leaves are capped at (twigs bend at the section their leaves need,
+/// `physics::section_floor`), or the twig rings with the leaves it carries (a leaf cluster
+/// pulls on the ring it shares with its segment).
 #[test]
 fn leaves_move_faster_than_their_segments_in_gusty_wind() {
     let tree = aspen(0.2);
@@ -103,7 +105,7 @@ fn leaves_move_faster_than_their_segments_in_gusty_wind() {
         assert!(rms >= 5.0, "{method}: leaves turn {rms:.2}° RMS, under 5°");
         assert!(median(&lp) > median(&sp), "{method}: leaf peak {} Hz, segments' {} Hz", median(&lp), median(&sp));
         if method == "hsm" {
-            assert!(6 * above >= 5 * probes.len(), "{method}: {above}/{} leaves above their segments", probes.len());
+            assert!(3 * above >= 2 * probes.len(), "{method}: {above}/{} leaves above their segments", probes.len());
         } else {
             assert_eq!(above, probes.len(), "{method}: leaf peaks {lp:?}, segment peaks {sp:?}");
         }
@@ -259,8 +261,9 @@ fn leaf_rotations_are_the_same_on_any_thread_count() {
 /// Every shipped Weber–Penn species' leaves ring above the twig that carries them (the
 /// twig's first mode from the wood, [`sylva_core::physics::stem_frequencies`]) wherever that
 /// twig rings below the leaves' cap, and every leaf mode stays within what a 60 Hz step
-/// resolves. On the aspen no floor binds: each leaf's frequency is the petiole cantilever's,
-/// `√(E π d⁴ / 64 / l_p / J) / 2π`, computed here from the blade (to 1e-4).
+/// resolves. On the aspen each leaf's frequency is the petiole cantilever's,
+/// `√(E π d⁴ / 64 / l_p / J) / 2π`, computed here from the blade, or 1.25 times its twig's
+/// where that is higher, under the cap (to 1e-4).
 #[test]
 fn every_species_leaves_ring_above_their_twigs() {
     use sylva_core::leaves::{ABOVE_TWIG, LeafMotion, MAX_LEAF_HZ};
@@ -289,11 +292,14 @@ fn every_species_leaves_ring_above_their_twigs() {
             assert!(leaf > twig, "{}: leaf {l} rings at {leaf} Hz, its twig at {twig} Hz", p.name);
             ratios.push(leaf / twig);
         }
+        let below = if ratios.is_empty() {
+            "none below the cap".to_string()
+        } else {
+            format!("median {:.2}, lowest {:.2}", median(&ratios), ratios.iter().fold(f32::MAX, |a, b| a.min(*b)))
+        };
         println!(
-            "{}: leaf swing over its twig's frequency: median {:.2}, lowest {:.2}; {capped} of {} leaves on twigs ringing past the {MAX_LEAF_HZ} Hz cap; fastest leaf mode {highest_hz:.1} Hz",
+            "{}: leaf swing over its twig's frequency: {below}; {capped} of {} leaves on twigs ringing past the {MAX_LEAF_HZ} Hz cap; fastest leaf mode {highest_hz:.1} Hz",
             p.name,
-            median(&ratios),
-            ratios.iter().fold(f32::MAX, |a, b| a.min(*b)),
             tree.leaves.len()
         );
         assert!(highest_hz <= MAX_LEAF_HZ * 1.0001, "{}: a leaf mode at {highest_hz} Hz", p.name);
@@ -306,7 +312,9 @@ fn every_species_leaves_ring_above_their_twigs() {
                 let lp = lm.petiole_ratio * len;
                 let ei = lm.petiole_modulus * std::f32::consts::PI * (lm.petiole_diameter_ratio * w).powi(4) / 64.0;
                 let j = mass * ((lp + 0.5 * len).powi(2) + len * len / 12.0);
-                let expected = (ei / lp / j).sqrt();
+                let twig = modes.omega[tree.segments.stem[tree.leaves.segment[l] as usize] as usize];
+                let cap = std::f32::consts::TAU * MAX_LEAF_HZ;
+                let expected = (ei / lp / j).sqrt().max((ABOVE_TWIG * twig).min(cap)).min(cap);
                 assert!(
                     (m.omega / expected - 1.0).abs() < 1e-4,
                     "aspen leaf {l}: {} rad/s against the petiole's {expected}",

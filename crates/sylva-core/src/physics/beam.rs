@@ -4,8 +4,8 @@
 //! tip's deflection under the drag on all of that ([`drag_bend`]).
 //!
 //! The beam is integrated in [`PIECES`] pieces per segment, each with the section at its
-//! middle (radii tapering from the segment's base to its tip, never under the minimum
-//! radius): the moment from every load beyond a point, curvature `M / E I`, slope and
+//! middle (radii tapering from the segment's base to its tip, never under the section that
+//! carries its leaves, [`super::section_floor`]): the moment from every load beyond a point, curvature `M / E I`, slope and
 //! deflection. The frequency is Rayleigh's quotient with the static deflection under the
 //! stem's own weight as the mode shape (the "static deflection method"; for a uniform
 //! cantilever it gives 3.53 √(EI/ρA)/L² against the exact 1.875² = 3.516, 0.4 % high):
@@ -75,14 +75,15 @@ pub struct DragBend {
 
 /// Each stem's static bend under the drag of the stem and of everything growing from it
 /// (`cd_area`: each segment's `C_d A`, [`drag_areas`]): each segment's own drag spread along
-/// it, every side stem's whole subtree where it starts; sections never thinner than
-/// `min_radius` (m).
+/// it, every side stem's whole subtree where it starts; sections never thinner than their
+/// [`super::section_floor`] over `min_radius` (m).
 pub fn drag_bend(tree: &Tree, min_radius: f32, cd_area: &[f32]) -> DragBend {
     let subtree = subtree_sums(tree, cd_area);
+    let floor = super::section_floor(tree, min_radius);
     let mut beam = Beam::default();
     let (mut tip, mut pressure_centre) = (Vec::new(), Vec::new());
     for k in 0..tree.stems.len() {
-        beam.bend(tree, k, cd_area, &subtree, min_radius);
+        beam.bend(tree, k, cd_area, &subtree, &floor);
         let y_tip = beam.tip();
         let (mut force, mut work) = (0.0f64, 0.0f64);
         for &(f, y) in &beam.loads {
@@ -95,16 +96,17 @@ pub fn drag_bend(tree: &Tree, min_radius: f32, cd_area: &[f32]) -> DragBend {
     DragBend { tip, pressure_centre }
 }
 
-/// The first bending mode of every stem of `tree`, with sections never thinner than
-/// `min_radius` (m). Stems with no mass or no compliance get 0 rad/s.
+/// The first bending mode of every stem of `tree`, with sections never thinner than their
+/// [`super::section_floor`] over `min_radius` (m). Stems with no mass or no compliance get 0 rad/s.
 pub fn stem_frequencies(tree: &Tree, min_radius: f32) -> StemModes {
     let own = segment_masses(tree);
     let subtree_mass = subtree_sums(tree, &own);
+    let floor = super::section_floor(tree, min_radius);
     let mut beam = Beam::default();
     let omega = (0..tree.stems.len())
         .map(|k| {
             // Loads equal to the masses (g = 1); Rayleigh's sums over the deflections.
-            beam.bend(tree, k, &own, &subtree_mass, min_radius);
+            beam.bend(tree, k, &own, &subtree_mass, &floor);
             let (mut work, mut kinetic) = (0.0f64, 0.0f64);
             for &(m, y) in &beam.loads {
                 work += m * y;
@@ -159,7 +161,8 @@ struct Beam {
 impl Beam {
     /// Bends stem `k` under `own[i]` spread along each of its segments and `subtree[c]` where
     /// each side stem starts (unit loads give deflections per load).
-    fn bend(&mut self, tree: &Tree, k: usize, own: &[f32], subtree: &[f32], min_radius: f32) {
+    /// Sections are never thinner than `floor` (per segment, m).
+    fn bend(&mut self, tree: &Tree, k: usize, own: &[f32], subtree: &[f32], floor: &[f32]) {
         let s = &tree.segments;
         let first = tree.stems.first_segment[k] as usize;
         let count = tree.stems.segment_count[k] as usize;
@@ -172,7 +175,7 @@ impl Beam {
             let base = self.pieces.len();
             for p in 0..PIECES {
                 let t = (p as f32 + 0.5) / PIECES as f32;
-                let r = (s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * t).max(min_radius) as f64;
+                let r = (s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * t).max(floor[i]) as f64;
                 let ei = tree.wood.young_modulus as f64 * std::f64::consts::FRAC_PI_4 * r.powi(4);
                 self.pieces.push(Piece { x: x + p as f64 * h, h, ei, ..Default::default() });
                 self.at.push((base + p, 0.5 * h, load as f64 / PIECES as f64));

@@ -64,24 +64,65 @@ pub fn crown_shelter(tree: &Tree, bark_drag: f32, leaf_drag: f32) -> f32 {
     if drag > 0.0 { (CROWN_DRAG * frontal / drag).clamp(0.0, 1.0) } else { 1.0 }
 }
 
-/// Mechanical radius of each segment, m: its own base radius, but never thinner than
-/// `min_radius` nor than the radius whose section equals its children's together
+/// Thinnest radius each segment bends at, m: `min_radius`, and, on side stems, never
+/// thinner for the leaf area it carries (its own and everything beyond) than the tree's
+/// main branches are drawn. The pipe model (Shinozaki et al. 1964: a stem's section is
+/// proportional to the leaf area beyond it) with its constant read from the tree itself,
+/// the median over first-order branches of leaf area per section, so presets whose leaves
+/// are drawn large for looks are not stiffened. Generators taper a child by its parent's
+/// radius where it grows, so twigs near a branch's tip come out hair-thin under a metre of
+/// leafy shoot, and would sway slower than the trunk. The trunk keeps its drawn section,
+/// which the presets' field frequencies rest on.
+pub fn section_floor(tree: &Tree, min_radius: f32) -> Vec<f32> {
+    let s = &tree.segments;
+    let mut leaf_area = vec![0.0f32; s.len()];
+    for (k, &seg) in tree.leaves.segment.iter().enumerate() {
+        leaf_area[seg as usize] += std::f32::consts::FRAC_PI_4 * tree.leaves.width[k] * tree.leaves.length[k];
+    }
+    for i in (0..s.len()).rev() {
+        let carried: f32 = tree.children.of(i).iter().map(|&c| leaf_area[c as usize]).sum();
+        leaf_area[i] += carried;
+    }
+    let st = &tree.stems;
+    let mut per_section: Vec<f32> = (0..st.len())
+        .filter(|&k| st.level[k] == 1 && st.segment_count[k] > 0)
+        .map(|k| st.first_segment[k] as usize)
+        .filter(|&i| leaf_area[i] > 0.0 && s.radius_base[i] > 0.0)
+        .map(|i| leaf_area[i] / (std::f32::consts::PI * s.radius_base[i] * s.radius_base[i]))
+        .collect();
+    per_section.sort_by(f32::total_cmp);
+    let Some(&ratio) = per_section.get(per_section.len() / 2) else {
+        return vec![min_radius; s.len()];
+    };
+    let per_area = 1.0 / (std::f32::consts::PI * ratio);
+    let trunk = |i: usize| st.level[s.stem[i] as usize] == 0;
+    leaf_area
+        .iter()
+        .enumerate()
+        .map(|(i, &a)| if trunk(i) { min_radius } else { (a * per_area).sqrt().max(min_radius) })
+        .collect()
+}
+
+/// Mechanical radius of each segment, m: its own base radius, but never thinner than its
+/// [`section_floor`] nor than the radius whose section equals its children's together
 /// (Leonardo's rule — a joint carries what grows beyond it). Generators taper radii for
 /// looks; the mechanics of Akagi's joints and HSM's clusters need this.
 pub fn mechanical_radii(tree: &Tree, min_radius: f32) -> Vec<f32> {
     let s = &tree.segments;
+    let floor = section_floor(tree, min_radius);
     let mut r = vec![0.0f32; s.len()];
     for i in (0..s.len()).rev() {
         let carried: f32 = tree.children.of(i).iter().map(|&c| r[c as usize].powi(2)).sum();
-        r[i] = s.radius_base[i].max(min_radius).max(carried.sqrt());
+        r[i] = s.radius_base[i].max(floor[i]).max(carried.sqrt());
     }
     r
 }
 
 /// Radius at which each segment bends, m: its own base radius (the section the tree is
-/// drawn with), never under `min_radius`.
+/// drawn with), never under its [`section_floor`].
 pub fn bending_radii(tree: &Tree, min_radius: f32) -> Vec<f32> {
-    tree.segments.radius_base.iter().map(|r| r.max(min_radius)).collect()
+    let floor = section_floor(tree, min_radius);
+    tree.segments.radius_base.iter().zip(&floor).map(|(r, f)| r.max(*f)).collect()
 }
 
 /// What one stem carries, as a rod turning about its base joint.

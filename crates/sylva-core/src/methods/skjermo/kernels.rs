@@ -3,6 +3,7 @@
 
 use crate::methods::skjermo::{
     RawSkjermoMode, RawSkjermoState, RawSkjermoStem, RawSkjermoStep, RawSkjermoSway, bezier, bezier_d, frame,
+    transported_frame,
 };
 use crate::model::NONE;
 use crate::physics::oscillator::{damped_apply, damped_coefficients};
@@ -42,7 +43,8 @@ pub fn skjermo_step(
             let prest = stems[p].rest.map(v3);
             let pnow = [0, 1, 2, 3].map(|j| prest[j] + v3(prev[p].delta[j]));
             let shift = bezier(&pnow, st.attach) - bezier(&prest, st.attach);
-            (shift, frame(&pnow, v3(prev[p].orient), st.attach), frame(&prest, v3(st.parent_orient), st.attach))
+            let f_rest = frame(&prest, v3(st.parent_orient), st.attach);
+            (shift, transported_frame(&f_rest, bezier_d(&pnow, st.attach)), f_rest)
         };
         // Unbent control points re-attached, as displacements from rest.
         let mut d = [shift; 4];

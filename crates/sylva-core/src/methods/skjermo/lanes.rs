@@ -45,16 +45,41 @@ use std::ops::{Add, Sub};
 #[inline(always)]
 fn frame(tangent: V3, o: V3) -> [V3; 3] {
     let tan = unit_tangent(tangent);
-    let n = o.sub(tan.scale(o.dot(tan)));
-    // As in `unit_tangent`, the fallback normal (O along the tangent) only where a lane
-    // needs it.
+    let n = unit_normal(o.sub(tan.scale(o.dot(tan))), tan);
+    [tan, n, tan.cross(n)]
+}
+
+/// `n` (normal to the unit `tan`) made unit: one reciprocal where every lane is longer than
+/// 1e-6; else, as `methods::skjermo::unit_or`, each lane's own, with `tan`'s orthogonal (then
+/// X) where it is too short (O along the tangent).
+#[inline(always)]
+fn unit_normal(n: V3, tan: V3) -> V3 {
     let nl = n.length();
-    let n = if nl.cmp_gt(V::splat(1e-6)).all() {
+    if nl.cmp_gt(V::splat(1e-6)).all() {
         n.scale(V::ONE / nl)
     } else {
         n.axis_or(tan.any_orthogonal().axis_or(V3::splat(Vec3::X)))
-    };
-    [tan, n, tan.cross(n)]
+    }
+}
+
+/// The attachment frame now, as `methods::skjermo::transported_frame`: the rest frame
+/// (`t_rest`, `n_rest`) turned by the shortest arc to the parent curve's `tangent`; the rest
+/// frame itself in lanes whose tangent is the rest one.
+#[inline(always)]
+fn transported_frame(t_rest: V3, n_rest: V3, tangent: V3) -> [V3; 3] {
+    let t = unit_tangent(tangent);
+    let same = t.x.cmp_eq(t_rest.x) & t.y.cmp_eq(t_rest.y) & t.z.cmp_eq(t_rest.z);
+    if same.all() {
+        return [t_rest, n_rest, t_rest.cross(n_rest)];
+    }
+    let (k, c) = (t_rest.cross(t), t_rest.dot(t));
+    let one_c = V::ONE + c;
+    let turning = one_c.cmp_gt(V::splat(1e-6));
+    let turned = n_rest.scale(c).add(k.cross(n_rest)).add(k.scale(k.dot(n_rest) / turning.blend(one_c, V::ONE)));
+    let m = V3::select(turning, turned, n_rest);
+    let n = V3::select(same, n_rest, unit_normal(m.sub(t.scale(m.dot(t))), t));
+    let t = V3::select(same, t_rest, t);
+    [t, n, t.cross(n)]
 }
 
 /// The frame's unit tangent: `axis_or(Y)`, which where every lane is long enough (all but
@@ -201,13 +226,12 @@ pub fn build(
 const STATE_FLOATS: usize = 21 * LANES;
 const _: () = assert!(std::mem::size_of::<StateLanes>() == STATE_FLOATS * 4);
 
-/// Gathers the parents' previous state for the sixteen lanes of a group (a trunk or padding
-/// lane sees no displacement and the orientation vector `X`, as the reference's trunk frame;
-/// so does a lane whose parent lies outside `prev`, as in [`gather_avx2`]).
+/// Gathers the parents' previous displacements for the sixteen lanes of a group (a trunk or
+/// padding lane sees none; nor does a lane whose parent lies outside `prev`, as in
+/// [`gather_avx2`]).
 #[inline(always)]
-fn gather(parent: &[u32; LANES], prev: &[StateLanes]) -> ([V3; 4], V3) {
+fn gather(parent: &[u32; LANES], prev: &[StateLanes]) -> [V3; 4] {
     let mut d = [[[0.0f32; LANES]; 3]; 4];
-    let mut o = [[1.0f32; LANES], [0.0; LANES], [0.0; LANES]];
     for (l, &p) in parent.iter().enumerate() {
         let (g, pl) = (p as usize / LANES, p as usize % LANES);
         let Some(s) = prev.get(g) else {
@@ -218,33 +242,29 @@ fn gather(parent: &[u32; LANES], prev: &[StateLanes]) -> ([V3; 4], V3) {
             dj[1][l] = s.delta[j].y.as_array_ref()[pl];
             dj[2][l] = s.delta[j].z.as_array_ref()[pl];
         }
-        o[0][l] = s.orient.x.as_array_ref()[pl];
-        o[1][l] = s.orient.y.as_array_ref()[pl];
-        o[2][l] = s.orient.z.as_array_ref()[pl];
     }
     let v3 = |a: [[f32; LANES]; 3]| V3 { x: V::from(a[0]), y: V::from(a[1]), z: V::from(a[2]) };
-    ([v3(d[0]), v3(d[1]), v3(d[2]), v3(d[3])], v3(o))
+    [v3(d[0]), v3(d[1]), v3(d[2]), v3(d[3])]
 }
 
-/// [`gather`] with AVX2's gather instruction: fifteen component loads of eight lanes each,
-/// twice, instead of 240 scalar copies (the same values: a gather only moves bits). A parent
+/// [`gather`] with AVX2's gather instruction: twelve component loads of eight lanes each,
+/// twice, instead of 192 scalar copies (the same values: a gather only moves bits). A parent
 /// at or beyond the end of `prev` is read as none, so no lane reads out of bounds.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-fn gather_avx2(parent: &[u32; LANES], prev: &[StateLanes]) -> ([V3; 4], V3) {
+fn gather_avx2(parent: &[u32; LANES], prev: &[StateLanes]) -> [V3; 4] {
     use std::arch::x86_64::*;
     // `step` checks that every float index fits an i32.
     let last = (prev.len() * LANES).saturating_sub(1) as i32;
     let base = prev.as_ptr().cast::<f32>();
-    let mut c = [V::ZERO; 15];
-    c[12] = V::ONE;
+    let mut c = [V::ZERO; 12];
     for h in 0..2 {
         // SAFETY: AVX2 is enabled for this function. `parent` holds sixteen u32, read as two
         // unaligned halves of eight. A lane is gathered only where its parent is at most
-        // `last`, so its index `(p / 16) · 240 + p % 16 + 16 · component` lies inside `prev`
-        // (`prev` is `repr(C)` twenty-one lanes-of-sixteen per group, of which the first fifteen are read); other lanes keep `c`'s
-        // defaults. Stores go to `c`'s arrays, eight floats at offset 0 or 8.
+        // `last`, so its index `(p / 16) · 336 + p % 16 + 16 · component` lies inside `prev`
+        // (`prev` is `repr(C)`, twenty-one lanes-of-sixteen per group, of which the first
+        // twelve, the displacements, are read); other lanes keep `c`'s defaults. Stores go to `c`'s arrays, eight floats at offset 0 or 8.
         unsafe {
             let p = _mm256_loadu_si256(parent.as_ptr().add(8 * h).cast());
             let inside = _mm256_cmpeq_epi32(_mm256_min_epu32(p, _mm256_set1_epi32(last)), p);
@@ -261,7 +281,7 @@ fn gather_avx2(parent: &[u32; LANES], prev: &[StateLanes]) -> ([V3; 4], V3) {
         }
     }
     let v3 = |k: usize| V3 { x: c[k], y: c[k + 1], z: c[k + 2] };
-    ([v3(0), v3(3), v3(6), v3(9)], v3(12))
+    [v3(0), v3(3), v3(6), v3(9)]
 }
 
 /// A control point's displacement: the attachment's shift plus the frame's change applied to
@@ -350,9 +370,9 @@ fn groups_at(
         // SAFETY: `fast_gather` is set only at the AVX2 level, which `step` runs only where
         // the CPU has AVX2.
         #[allow(unsafe_code)]
-        let (dp, o_now) = if fast_gather { unsafe { gather_avx2(&st.parent, prev) } } else { gather(&st.parent, prev) };
+        let dp = if fast_gather { unsafe { gather_avx2(&st.parent, prev) } } else { gather(&st.parent, prev) };
         #[cfg(not(target_arch = "x86_64"))]
-        let (dp, o_now) = {
+        let dp = {
             let _ = fast_gather;
             gather(&st.parent, prev)
         };
@@ -370,11 +390,11 @@ fn groups_at(
             shift = shift.add(dj.scale(w[j]));
             tan = tan.add(dj.scale(e[j]));
         }
-        let f_now = frame(tan, o_now);
         // Written out, not with `array::map` or a closure: neither is inlined into the AVX2
         // body, and they would run as baseline code.
         let t_rest = unit_tangent(st.tan_rest);
         let b_rest = t_rest.cross(st.n_rest);
+        let f_now = transported_frame(t_rest, st.n_rest, tan);
         let df = [f_now[0].sub(t_rest), f_now[1].sub(st.n_rest), f_now[2].sub(b_rest)];
         // P0 and P1 only follow the attachment: written at once, so that fewer values stay
         // live across the wind.

@@ -83,6 +83,23 @@ fn frame(c: Curve, o: vec3<f32>, t: f32) -> Frame {
     return Frame(tan, n, cross(tan, n));
 }
 
+// sylva_core::methods::skjermo::transported_frame: the rest frame turned by the shortest arc
+// to the parent curve's tangent now; the rest frame itself where the tangent is the rest one.
+fn transported_frame(rest: Frame, tangent: vec3<f32>) -> Frame {
+    let t = unit_or(tangent, vec3<f32>(0.0, 1.0, 0.0));
+    if (all(t == rest.t)) {
+        return rest;
+    }
+    let k = cross(rest.t, t);
+    let c = dot(rest.t, t);
+    var m = rest.n;
+    if (1.0 + c > 1e-6) {
+        m = rest.n * c + cross(k, rest.n) + k * (dot(k, rest.n) / (1.0 + c));
+    }
+    let n = unit_or(m - t * dot(m, t), unit_or(any_orthogonal(t), vec3<f32>(1.0, 0.0, 0.0)));
+    return Frame(t, n, cross(t, n));
+}
+
 fn rest_curve(s: SkjermoStem) -> Curve {
     return Curve(array<vec3<f32>, 4>(s.rest[0].xyz, s.rest[1].xyz, s.rest[2].xyz, s.rest[3].xyz));
 }

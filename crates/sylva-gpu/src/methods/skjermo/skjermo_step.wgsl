@@ -37,8 +37,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let prest = rest_curve(p);
         let pnow = now_curve(p, prev[st.parent]);
         shift = bezier(pnow, st.attach) - bezier(prest, st.attach);
-        f_now = frame(pnow, prev[st.parent].orient.xyz, st.attach);
         f_rest = frame(prest, st.parent_orient.xyz, st.attach);
+        f_now = transported_frame(f_rest, bezier_d(pnow, st.attach));
     }
     var d: array<vec3<f32>, 4>;
     for (var j = 0u; j < 4u; j++) {
