@@ -5,10 +5,11 @@
 //!
 //! The beam is integrated in [`PIECES`] pieces per segment, each with the section at its
 //! middle (radii tapering from the segment's base to its tip, never under the section that
-//! carries its leaves, [`super::section_floor`]): the moment from every load beyond a point, curvature `M / E I`, slope and
-//! deflection. The frequency is Rayleigh's quotient with the static deflection under the
-//! stem's own weight as the mode shape (the "static deflection method"; for a uniform
-//! cantilever it gives 3.53 √(EI/ρA)/L² against the exact 1.875² = 3.516, 0.4 % high):
+//! carries its leaves, [`super::section_floor`]): the moment from every load beyond a point,
+//! curvature `M / E I`, slope and deflection. The frequency is Rayleigh's quotient with the
+//! static deflection under the stem's own weight as the mode shape (the "static deflection
+//! method"; for a uniform cantilever it gives 3.53 √(EI/ρA)/L² against the exact
+//! 1.875² = 3.516, 0.4 % high):
 //! `ω² = Σ m y / Σ m y²` over the stem's masses, with `y` the deflection under loads equal
 //! to those masses.
 
@@ -97,7 +98,8 @@ pub fn drag_bend(tree: &Tree, min_radius: f32, cd_area: &[f32]) -> DragBend {
 }
 
 /// The first bending mode of every stem of `tree`, with sections never thinner than their
-/// [`super::section_floor`] over `min_radius` (m). Stems with no mass or no compliance get 0 rad/s.
+/// [`super::section_floor`] over `min_radius` (m). Stems with no mass or no compliance get
+/// 0 rad/s.
 pub fn stem_frequencies(tree: &Tree, min_radius: f32) -> StemModes {
     let own = segment_masses(tree);
     let subtree_mass = subtree_sums(tree, &own);
@@ -119,7 +121,7 @@ pub fn stem_frequencies(tree: &Tree, min_radius: f32) -> StemModes {
 }
 
 /// Each segment's value summed with everything beyond it.
-fn subtree_sums(tree: &Tree, own: &[f32]) -> Vec<f32> {
+pub(crate) fn subtree_sums(tree: &Tree, own: &[f32]) -> Vec<f32> {
     let mut sum = own.to_vec();
     for i in (0..sum.len()).rev() {
         let carried: f32 = tree.children.of(i).iter().map(|&c| sum[c as usize]).sum();

@@ -75,14 +75,11 @@ pub fn crown_shelter(tree: &Tree, bark_drag: f32, leaf_drag: f32) -> f32 {
 /// which the presets' field frequencies rest on.
 pub fn section_floor(tree: &Tree, min_radius: f32) -> Vec<f32> {
     let s = &tree.segments;
-    let mut leaf_area = vec![0.0f32; s.len()];
+    let mut own = vec![0.0f32; s.len()];
     for (k, &seg) in tree.leaves.segment.iter().enumerate() {
-        leaf_area[seg as usize] += std::f32::consts::FRAC_PI_4 * tree.leaves.width[k] * tree.leaves.length[k];
+        own[seg as usize] += std::f32::consts::FRAC_PI_4 * tree.leaves.width[k] * tree.leaves.length[k];
     }
-    for i in (0..s.len()).rev() {
-        let carried: f32 = tree.children.of(i).iter().map(|&c| leaf_area[c as usize]).sum();
-        leaf_area[i] += carried;
-    }
+    let leaf_area = beam::subtree_sums(tree, &own);
     let st = &tree.stems;
     let mut per_section: Vec<f32> = (0..st.len())
         .filter(|&k| st.level[k] == 1 && st.segment_count[k] > 0)

@@ -264,7 +264,8 @@ fn gather_avx2(parent: &[u32; LANES], prev: &[StateLanes]) -> [V3; 4] {
         // unaligned halves of eight. A lane is gathered only where its parent is at most
         // `last`, so its index `(p / 16) · 336 + p % 16 + 16 · component` lies inside `prev`
         // (`prev` is `repr(C)`, twenty-one lanes-of-sixteen per group, of which the first
-        // twelve, the displacements, are read); other lanes keep `c`'s defaults. Stores go to `c`'s arrays, eight floats at offset 0 or 8.
+        // twelve, the displacements, are read); other lanes keep `c`'s defaults. Stores go to
+        // `c`'s arrays, eight floats at offset 0 or 8.
         unsafe {
             let p = _mm256_loadu_si256(parent.as_ptr().add(8 * h).cast());
             let inside = _mm256_cmpeq_epi32(_mm256_min_epu32(p, _mm256_set1_epi32(last)), p);

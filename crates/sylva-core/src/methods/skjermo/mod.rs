@@ -186,7 +186,8 @@ pub fn frame_from_tangent(tangent: Vec3, o: Vec3) -> [Vec3; 3] {
 /// to the parent curve's `tangent` now (not necessarily unit), so a child turns with its
 /// parent's bend and does not twist about it. Where the tangent is the rest one (still air)
 /// this is `rest` itself, bit for bit; where it has turned half round, the rest normal. The
-/// normal is made normal to the tangent again after the turn. WGSL: `transported_frame` in `skjermo.wgsl`.
+/// normal is made normal to the tangent again after the turn. WGSL: `transported_frame` in
+/// `skjermo.wgsl`.
 pub fn transported_frame(rest: &[Vec3; 3], tangent: Vec3) -> [Vec3; 3] {
     let t = unit_or(tangent, Vec3::Y);
     if t == rest[0] {
