@@ -1,13 +1,31 @@
 //! Tuning HSM to the wood. Shape matching gives each cluster a rate (1/s²), not a modulus,
 //! and a chain of clusters held through ring levers is stiffer than the beam it stands for
 //! (and, where it is stiffer than the substep, held by the hold instead). So the method
-//! measures its own trunk once: a lateral load switched on at rest in still air, no damping
-//! and no drag, swings the trunk top to its first peak after half a period. Every rate
-//! scales the dynamics' frequencies by its square root (the hold scales with them), so one
-//! measurement gives the factor that puts the trunk at its first mode from the wood.
+//! measures its own stems once, in still air without damping or drag, and scales their
+//! rates until each rings at its first mode from the wood,
+//! [`crate::physics::stem_frequencies`].
+//!
+//! Scaling every rate and the hold by `s` scales every frequency of the dynamics by `√s`,
+//! so the stems are plucked as built and compared with their targets times the trunk's
+//! `ratio` (its frequency as built over its target); one scale by `1 / ratio²` at the end
+//! puts them all where they belong, and no pluck runs at the slower calibrated pace.
+//! 1. The trunk: a lateral load switched on at rest swings its top to its first peak after
+//!    half a period ([`trunk_frequency`]).
+//! 2. Every level of side stems, deepest first (a stem carries its children): the levels
+//!    below are held at rest, as the beam model clamps a stem at its base, and each stem is
+//!    set moving across its axis with all it carries; its tip reaches its first peak after a
+//!    quarter period ([`side_stem_frequencies`]). Each stem's clusters get their own factor.
+//!    One scale for the whole tree left the aspen's branches and twigs at about half their
+//!    beam frequency: a chain of a few short clusters stands for its beam differently from
+//!    the trunk's long one.
+//! 3. The trunk again: stiffer side stems hold more of the crown's mass to it (and weigh
+//!    more on the rings they share with it), so its own clusters are scaled back to the
+//!    frequency of step 1.
 
+use super::raw::kind;
 use super::{FIXED, Hsm};
 use crate::model::{NONE, Tree};
+use glam::Vec3;
 
 /// Lateral acceleration of the pluck, m/s² (the dynamics are linear in it but for large
 /// bends; 1 m/s² bends a tree by a small fraction of the wind's).
@@ -16,24 +34,38 @@ const LOAD: f32 = 1.0;
 /// Longest pluck simulated, s: a trunk slower than 1/(2 · 20 s) is left uncalibrated.
 const LONGEST: f32 = 20.0;
 
+/// Longest trunk pluck as built, in periods of the trunk's target: a trunk 32 times slower
+/// than its mode from the wood (or one whose top does not ring, as a short bole under a
+/// spreading crown may not) is left as built.
+const FIRST: f32 = 16.0;
+
+/// Longest trunk pluck after the side stems are scaled, in periods as built: a trunk that
+/// slows by more than 8 times is left so.
+const AGAIN: f32 = 4.0;
+
+/// Speed a side stem is set moving at, m/s (small: the dynamics are linear in it).
+const SPEED: f32 = 0.01;
+
+/// Bounds of a stem's own factor on its rates: a stem that the hold keeps from following
+/// its rate is not stiffened without end, and one that misses its peak (read at the deadline)
+/// gets the bound.
+const STEM_FACTOR: (f32, f32) = (1.0 / 16.0, 16.0);
+
 /// The trunk's first-mode frequency under `hsm`'s own dynamics at its substep rate, Hz:
 /// half the inverse of the time the trunk top's tail ring takes to reach its first peak
 /// after a step load. `None` without a substep rate, without a trunk cluster, or when no
 /// peak comes within `LONGEST` seconds.
 pub fn trunk_frequency(tree: &Tree, hsm: &Hsm) -> Option<f32> {
-    let rate = hsm.params.substep_rate;
-    if rate <= 0.0 {
+    trunk_pluck(tree, hsm, LONGEST)
+}
+
+/// [`trunk_frequency`], giving up after `longest` seconds.
+fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<f32> {
+    let rate = hsm.params.substep_rate * hsm.layout.rate_scale.max(1.0).sqrt();
+    if rate <= 0.0 || tree.stems.is_empty() {
         return None;
     }
-    let top = (tree.stems.first_segment[0] + tree.stems.segment_count[0] - 1) as usize;
-    let c = hsm.layout.segment_cluster[top];
-    if c == NONE {
-        return None;
-    }
-    let info = hsm.layout.info[c as usize];
-    let k = hsm.params.ring_size.min(info.slot_count);
-    let end = (info.slot_offset + info.slot_count) as usize;
-    let ring: Vec<usize> = hsm.layout.slots[end - k as usize..end].iter().map(|s| s.particle as usize).collect();
+    let ring = tip_ring(tree, hsm, 0)?;
     let mut state = hsm.state_at_rest();
     for v in &mut state.velocity {
         if v[3] != FIXED {
@@ -46,7 +78,7 @@ pub fn trunk_frequency(tree: &Tree, hsm: &Hsm) -> Option<f32> {
     step.damping = 1.0;
     let mut x: Vec<f32> = Vec::new();
     let (mut best, mut at) = (0.0f32, 0usize);
-    for i in 0..(LONGEST * rate) as usize {
+    for i in 0..(longest.min(LONGEST) * rate) as usize {
         step.time = (i + 1) as f32 * h;
         hsm.substep_with(&[], &[], &mut state, step);
         let xi = ring.iter().map(|&p| state.displacement[p][0]).sum::<f32>() / ring.len() as f32;
@@ -57,13 +89,172 @@ pub fn trunk_frequency(tree: &Tree, hsm: &Hsm) -> Option<f32> {
         if xi > best {
             (best, at) = (xi, i);
         } else if best > 0.0 && xi < 0.5 * best {
-            // Past the first peak: refine it on the parabola through its neighbours.
-            let (a, b, c) = (x[at.saturating_sub(1)] as f64, best as f64, x[at + 1] as f64);
-            let curve = a - 2.0 * b + c;
-            let shift = if at > 0 && curve < 0.0 { (0.5 * (a - c) / curve).clamp(-0.5, 0.5) } else { 0.0 };
-            let peak = (at as f64 + 1.0 + shift) * h as f64;
-            return Some((0.5 / peak) as f32);
+            return Some(0.5 / refine(&x, at, h));
         }
     }
     None
+}
+
+/// The first-mode frequency of every stem of `level` under `hsm`'s dynamics, Hz, with the
+/// levels below held at rest: one entry per stem of the tree, `None` for the other levels
+/// and for stems the layout has no cluster for. Each stem, with all it carries, is set
+/// moving across its axis at rest and its tip ring reaches its first peak after a quarter
+/// period. A stem still rising after `deadline(stem)` seconds reads as that long a quarter
+/// period.
+pub fn side_stem_frequencies(tree: &Tree, hsm: &Hsm, level: u8, deadline: impl Fn(usize) -> f32) -> Vec<Option<f32>> {
+    let st = &tree.stems;
+    let l = &hsm.layout;
+    let mut out = vec![None; st.len()];
+    let rate = hsm.params.substep_rate * l.rate_scale.max(1.0).sqrt();
+    if rate <= 0.0 {
+        return out;
+    }
+    // The stem of `level` that carries each stem, and the direction it is pushed in:
+    // horizontal and square to its axis (or along x for an upright stem).
+    let mut carrier = vec![NONE; st.len()];
+    let mut push = vec![Vec3::ZERO; st.len()];
+    for k in 0..st.len() {
+        carrier[k] = if st.level[k] == level {
+            k as u32
+        } else if st.level[k] > level && st.parent[k] != NONE && (st.parent[k] as usize) < k {
+            carrier[st.parent[k] as usize]
+        } else {
+            NONE
+        };
+        if st.level[k] == level && st.segment_count[k] > 0 {
+            let first = st.first_segment[k] as usize;
+            let last = first + st.segment_count[k] as usize - 1;
+            let axis = (tree.segments.end(last) - tree.segments.start[first]).normalize_or_zero();
+            let across = axis.cross(Vec3::Y);
+            push[k] = if across.length() > 0.1 { across.normalize() } else { Vec3::X };
+        }
+    }
+    // Each stem's tip ring.
+    let mut probes: Vec<(usize, Vec<usize>, f32)> = Vec::new();
+    for k in (0..st.len()).filter(|&k| st.level[k] == level && st.segment_count[k] > 0) {
+        if let Some(ring) = tip_ring(tree, hsm, k) {
+            probes.push((k, ring, deadline(k)));
+        }
+    }
+    let stem_of = |c: usize| {
+        let info = l.info[c];
+        match info.kind {
+            kind::SEGMENT => tree.segments.stem[info.source as usize],
+            kind::LEAF => tree.segments.stem[tree.leaves.segment[info.source as usize] as usize],
+            _ => info.source,
+        }
+    };
+    let mut state = hsm.state_at_rest();
+    for (p, v) in state.velocity.iter_mut().enumerate() {
+        if v[3] == FIXED {
+            continue;
+        }
+        let k = carrier[stem_of(l.owner[p] as usize) as usize];
+        if k == NONE {
+            v[3] = FIXED;
+        } else {
+            let w = push[k as usize] * SPEED;
+            *v = [w.x, w.y, w.z, 0.0];
+        }
+    }
+    let h = 1.0 / rate;
+    let mut step = hsm.step_params(0.0, h);
+    step.gravity = [0.0; 4];
+    step.damping = 1.0;
+    let longest = probes.iter().map(|p| p.2).fold(0.0f32, f32::max).min(LONGEST);
+    let mut x: Vec<Vec<f32>> = vec![Vec::new(); probes.len()];
+    let mut best = vec![(0.0f32, 0usize); probes.len()];
+    let mut done = vec![false; probes.len()];
+    let mut open = probes.len();
+    for i in 0..(longest * rate).ceil() as usize {
+        if open == 0 {
+            break;
+        }
+        step.time = (i + 1) as f32 * h;
+        hsm.substep_with(&[], &[], &mut state, step);
+        for (q, (k, ring, until)) in probes.iter().enumerate() {
+            if done[q] {
+                continue;
+            }
+            let d = ring.iter().map(|&p| Vec3::from_slice(&state.displacement[p][..3])).sum::<Vec3>();
+            let xi = d.dot(push[*k]) / ring.len() as f32;
+            if !xi.is_finite() {
+                (done[q], open) = (true, open - 1);
+                continue;
+            }
+            x[q].push(xi);
+            let (b, at) = &mut best[q];
+            if xi > *b {
+                (*b, *at) = (xi, i);
+            }
+            let past = *b > 0.0 && xi < 0.5 * *b;
+            if past || step.time >= *until {
+                let peak = if past { refine(&x[q], *at, h) } else { *until };
+                out[*k] = Some(0.25 / peak);
+                (done[q], open) = (true, open - 1);
+            }
+        }
+    }
+    out
+}
+
+/// The particles of stem `k`'s tip ring: its last segment cluster's tail ring.
+fn tip_ring(tree: &Tree, hsm: &Hsm, k: usize) -> Option<Vec<usize>> {
+    let count = tree.stems.segment_count[k];
+    if count == 0 {
+        return None;
+    }
+    let top = (tree.stems.first_segment[k] + count - 1) as usize;
+    let c = hsm.layout.segment_cluster[top];
+    if c == NONE {
+        return None;
+    }
+    let info = hsm.layout.info[c as usize];
+    let n = hsm.params.ring_size.min(info.slot_count) as usize;
+    let end = (info.slot_offset + info.slot_count) as usize;
+    Some(hsm.layout.slots[end - n..end].iter().map(|s| s.particle as usize).collect())
+}
+
+/// The time of the peak of `x` at step `at` (step `i` ends at `(i + 1) h`), refined on the
+/// parabola through its neighbours.
+fn refine(x: &[f32], at: usize, h: f32) -> f32 {
+    let (a, b, c) = (x[at.saturating_sub(1)] as f64, x[at] as f64, x[at + 1] as f64);
+    let curve = a - 2.0 * b + c;
+    let shift = if at > 0 && curve < 0.0 { (0.5 * (a - c) / curve).clamp(-0.5, 0.5) } else { 0.0 };
+    ((at as f64 + 1.0 + shift) * h as f64) as f32
+}
+
+/// Puts the trunk and every side stem at its first mode from the wood (see the module
+/// docs): scales the layout's rates in place. Does nothing when the trunk gives no peak.
+pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
+    let target = hsm.layout.sway_hz * hsm.params.stiffness_scale.sqrt();
+    let Some(f0) = trunk_pluck(tree, hsm, FIRST / target) else {
+        return;
+    };
+    // Plucked as built, every frequency is `ratio` times what it will be once scaled.
+    let ratio = f0 / target;
+    let modes = crate::physics::stem_frequencies(tree, hsm.params.min_radius);
+    let want = |k: usize| modes.hz(k) * hsm.params.stiffness_scale.sqrt() * ratio;
+    let deepest = tree.stems.level.iter().copied().max().unwrap_or(0);
+    for level in (1..=deepest).rev() {
+        let measured = side_stem_frequencies(tree, hsm, level, |k| 1.0 / want(k).max(1e-3));
+        let factors: Vec<f32> = measured
+            .iter()
+            .enumerate()
+            .map(|(k, f)| match f {
+                Some(f) if *f > 0.0 => (want(k) / f).powi(2).clamp(STEM_FACTOR.0, STEM_FACTOR.1),
+                _ => 1.0,
+            })
+            .collect();
+        hsm.layout.scale_stem_rates(tree, &factors);
+    }
+    // Stiffer side stems load the trunk more: it is brought back to where it was.
+    if deepest > 0
+        && let Some(f1) = trunk_pluck(tree, hsm, AGAIN / f0)
+    {
+        let mut factors = vec![1.0; tree.stems.len()];
+        factors[0] = (f0 / f1).powi(2).clamp(STEM_FACTOR.0, STEM_FACTOR.1);
+        hsm.layout.scale_stem_rates(tree, &factors);
+    }
+    hsm.layout.scale_rates((target / f0).powi(2).clamp(1e-4, 1e4));
 }

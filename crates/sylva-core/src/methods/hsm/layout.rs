@@ -414,6 +414,20 @@ impl HsmLayout {
         self.rate_scale *= s;
     }
 
+    /// Multiplies the rates of each stem's segment clusters and stem cluster by its entry of
+    /// `factors` (one per stem of the tree; leaves keep theirs) and recomputes the path bounds.
+    pub fn scale_stem_rates(&mut self, tree: &Tree, factors: &[f32]) {
+        for (c, info) in self.clusters.iter_mut().zip(&self.info) {
+            let stem = match info.kind {
+                kind::SEGMENT => tree.segments.stem[info.source as usize],
+                kind::STEM => info.source,
+                _ => continue,
+            };
+            c.rest_cm[3] *= factors.get(stem as usize).copied().unwrap_or(1.0);
+        }
+        path_bounds(&mut self.clusters);
+    }
+
     /// Number of clusters.
     pub fn cluster_count(&self) -> usize {
         self.info.len()

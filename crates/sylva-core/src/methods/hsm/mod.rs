@@ -81,9 +81,10 @@
 //! times larger (mass scaling), by the same factor at any step, and substeps rise until
 //! `s (r h)² ≤ 1`, so Müller's stability is kept and the same tree sways alike at 30, 60,
 //! 120 or 240 frames/s. The scale `s` comes from the wood ([`calibrate`]): the trunk,
-//! plucked once when the method is built, sways at its first mode from
-//! [`crate::physics::stem_frequencies`]. Damping is a ratio of that mode
-//! ([`HsmParams::damping_ratio`]); the drag adds the air's.
+//! plucked when the method is built, sways at its first mode from
+//! [`crate::physics::stem_frequencies`], and each side stem, plucked with its parent held,
+//! at its own (a factor on its clusters' rates besides `s`). Damping is a ratio of the
+//! trunk's mode ([`HsmParams::damping_ratio`]); the drag adds the air's.
 //!
 //! **Rotation**: `R` is extracted by the iterative method of Müller, Bender, Chentanez &
 //! Macklin (2016), warm-started from the last step's R, `R ← rot(ω) R` (the unit
@@ -195,10 +196,7 @@ impl Hsm {
         let layout = HsmLayout::new(tree, &params, None)?;
         let mut hsm = Self::from_layout(tree, params, layout);
         if params.calibrate && params.substep_rate > 0.0 {
-            let target = hsm.layout.sway_hz * params.stiffness_scale.sqrt();
-            if let Some(f) = calibrate::trunk_frequency(tree, &hsm) {
-                hsm.layout.scale_rates((target / f).powi(2).clamp(1e-4, 1e4));
-            }
+            calibrate::calibrate(tree, &mut hsm);
         }
         Ok(hsm)
     }

@@ -125,12 +125,12 @@ pub struct HsmParams {
     /// `substeps` substeps with Müller's clamp `ᾱ ≤ 1` (Song's tables), so the stiffness
     /// then follows the step.
     pub substep_rate: f32,
-    /// Scale every segment and stem cluster's rate (and the hold) so that the trunk sways at
-    /// its first mode from the wood, [`crate::physics::stem_frequencies`] (times
-    /// `√stiffness_scale`): HSM's trunk is plucked once when the method is built and its
-    /// frequency measured (see [`super::calibrate`]). Default true: shape matching's clusters have
-    /// a rate each but no modulus, and their ring levers make a chain of them stiffer than
-    /// the beam it stands for. Leaves keep their petioles' rates. Needs `substep_rate > 0`.
+    /// Scale the segment and stem clusters' rates (and the hold) so that the trunk and every
+    /// side stem sway at their first modes from the wood, [`crate::physics::stem_frequencies`]
+    /// (times `√stiffness_scale`): HSM plucks its stems when the method is built and measures
+    /// them (see [`super::calibrate`]). Default true: shape matching's clusters have a rate
+    /// each but no modulus, and their ring levers make a chain of them stiffer than the beam
+    /// it stands for. Leaves keep their petioles' rates. Needs `substep_rate > 0`.
     pub calibrate: bool,
 }
 
