@@ -489,6 +489,28 @@ fn hsm_side_stems_ring_at_their_own_beam_frequency() {
     }
 }
 
+/// The black oak's trunk is a short, thick bole under a spreading crown: under HSM's step
+/// load its top swings to a first peak and then hovers at about 0.7 of it, handing its swing
+/// to the crown's branches, instead of falling back to rest. Calibration read that peak only
+/// once the top fell below half of it: the full oak gave no peak and was left as built
+/// (ringing at 0.57 of its beam frequency), and this half-size one gave a slow swing of the
+/// crown many seconds on (0.23 Hz) and was stiffened 161×. Read once the top falls below
+/// 0.85 of its peak, the first peak comes within a beam period and the oak is calibrated.
+#[test]
+fn hsm_calibrates_a_bole_whose_top_does_not_fall_back_to_half_its_first_peak() {
+    use sylva_core::methods::hsm::HsmLayout;
+    use sylva_core::methods::hsm::calibrate::trunk_frequency;
+    let t = species("ca_black_oak", 0.5, 1);
+    let params = HsmParams::default();
+    let built = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, None).unwrap());
+    let f = trunk_frequency(&t, &built).expect("the oak's trunk peaks as built");
+    let a = hsm(&t);
+    let beam = stem_frequencies(&t, a.params.min_radius).hz(0);
+    println!("black oak: trunk as built {f:.3} Hz, beam {beam:.3} Hz, rate scale {}", a.layout.rate_scale);
+    assert!(f > 0.1 * beam && f < beam, "as built {f} Hz against the beam's {beam} Hz");
+    assert!((a.layout.rate_scale - 1.0).abs() > 0.1, "rate scale {}", a.layout.rate_scale);
+}
+
 /// Zioma's trunk answers the wind as a damped oscillator at the trunk's own frequency, in
 /// closed form: a gentle sine at f₀ on a steady breeze swings it at least 3× as far as the
 /// same sine at 0.4 f₀, and at both as far as Skjermo's integrated oscillator swings (within
