@@ -369,32 +369,40 @@ fn ten_minutes_of_hurricane_stay_stable_and_recover() {
 }
 
 /// Every preset (its first 600 clusters, grown from the root): a 1,000-step storm stays
-/// finite and bounded, and a minute of calm brings it back within 1 % of its height.
+/// finite and bounded, and a minute of calm brings it back within 1 % of its height. (The
+/// presets run side by side: a layout this small steps on one thread.)
 #[test]
 fn every_preset_survives_a_storm_and_returns_to_rest() {
+    use rayon::prelude::*;
     let fw = storm(40.0).packed();
-    for p in PRESETS {
-        let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
-        let params = HsmParams::default();
-        let layout = HsmLayout::new(&t, &params, Some(600)).unwrap();
-        let h = Hsm::from_layout(&t, params, layout);
-        let mut s = h.state_at_rest();
-        let rest = s.clone();
-        let mut peak = 0.0f32;
-        for _ in 0..1_000 {
-            h.step_packed(&fw.fields, &fw.waves, &mut s, 1.0 / 60.0);
-            peak = peak.max(s.max_distance(&rest));
-        }
-        assert!(s.displacement.iter().all(|p| p.iter().all(|v| v.is_finite())), "{}: NaN", p.name);
-        assert!(max_speed(&s) < 80.0, "{}: a particle at {} m/s", p.name, max_speed(&s));
+    let runs: Vec<(bool, f32, f32, f32, f32)> = PRESETS
+        .par_iter()
+        .map(|p| {
+            let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
+            let params = HsmParams::default();
+            let layout = HsmLayout::new(&t, &params, Some(600)).unwrap();
+            let h = Hsm::from_layout(&t, params, layout);
+            let mut s = h.state_at_rest();
+            let rest = s.clone();
+            let mut peak = 0.0f32;
+            for _ in 0..1_000 {
+                h.step_packed(&fw.fields, &fw.waves, &mut s, 1.0 / 60.0);
+                peak = peak.max(s.max_distance(&rest));
+            }
+            let finite = s.displacement.iter().all(|p| p.iter().all(|v| v.is_finite()));
+            let speed = max_speed(&s);
+            // A minute of calm: the structural damping alone (ζ 0.04 of the trunk's mode,
+            // a decay time of 1/(ζ ω₀) ≈ 4–7 s), as a tree rings down in still air.
+            for _ in 0..3_600 {
+                h.step_packed(&[], &[], &mut s, 1.0 / 60.0);
+            }
+            (finite, speed, peak, s.max_distance(&rest), t.height())
+        })
+        .collect();
+    for (p, &(finite, speed, peak, d, height)) in PRESETS.iter().zip(&runs) {
+        assert!(finite, "{}: NaN", p.name);
+        assert!(speed < 80.0, "{}: a particle at {speed} m/s", p.name);
         assert!(peak > 1e-3, "{}: the storm moved nothing", p.name);
-        // A minute of calm: the structural damping alone (ζ 0.04 of the trunk's mode,
-        // a decay time of 1/(ζ ω₀) ≈ 4–7 s), as a tree rings down in still air.
-        for _ in 0..3_600 {
-            h.step_packed(&[], &[], &mut s, 1.0 / 60.0);
-        }
-        let d = s.max_distance(&rest);
-        let height = t.height();
         println!("{:<16} peak {peak:.3} m, after calm {d:.2e} m (height {height:.1} m)", p.name);
         // Known limit, open in the tracker: the palm's leaflets are long blades on thin
         // rings, so a leaf cluster's rigid fit barely feels its petiole ring and a leaflet
