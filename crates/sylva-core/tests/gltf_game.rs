@@ -383,6 +383,7 @@ fn only_the_finest_level_is_in_the_scene_and_msft_lod_names_the_others() {
 #[test]
 fn the_packed_hierarchy_decodes_to_the_custom_attributes() {
     let t = tree("quaking_aspen");
+    let near = 1e-6 * t.height();
     for quantize in [false, true] {
         let opts = GltfOptions { custom_attributes: true, quantize, ..GltfOptions::game(&t, &GAME_BUDGET) };
         let f = read(&glb(&t, None, &opts));
@@ -396,7 +397,7 @@ fn the_packed_hierarchy_decodes_to_the_custom_attributes() {
             assert_eq!(t1[v][0].floor(), depth[v][0], "depth of vertex {v}");
             assert!((t1[v][0].fract() - phase[v][0].min(PHASE_MAX)).abs() < 1e-4, "phase of vertex {v}");
             let p = Vec3::new(t2[v][0], t1[v][1], t2[v][1]);
-            assert!(p.distance(Vec3::from_slice(&pivot[v])) < 1e-6 * t.height(), "pivot of vertex {v}");
+            assert!(p.distance(Vec3::from_slice(&pivot[v])) < near, "pivot of vertex {v}");
             let a = octahedral_decode(t3[v]);
             worst_axis = worst_axis.max(angle(a, Vec3::from_slice(&axis[v])));
         }

@@ -422,7 +422,7 @@ pub fn build_gltf(tree: &Tree, clip: Option<&Clip>, opts: &GltfOptions) -> Resul
     let card_mat = card_tex.map(|(t, n)| b.root.push(material("leaf_card", t, n, 0.55, true)));
 
     // Skin: the armature and its joints.
-    let height = tree.bounds().1.y - tree.bounds().0.y;
+    let height = tree.height();
     let rest: Vec<Vec3> =
         rig.driver.iter().map(|&s| tree.segments.start[s]).chain(rig.leaf_groups.iter().map(|g| g.pivot)).collect();
     let parent: Vec<u32> = rig.parent.iter().copied().chain(rig.leaf_groups.iter().map(|g| g.parent)).collect();
