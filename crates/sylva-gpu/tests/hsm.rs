@@ -106,7 +106,10 @@ fn hsm_matches_after_600_steps_on_every_preset() {
     let fw = wind.packed();
     for p in PRESETS {
         let t = SpeciesSource::from_preset(p).unwrap().generate(1, &Default::default(), None).unwrap();
-        let params = HsmParams { substep_rate: 240.0, ..Default::default() };
+        // A truncated layout is not calibrated, so its drag is not scaled to the beam's
+        // lean (11× on the aspen): the scale here makes every tree move well past the
+        // tolerance (the fir's sheltered crown moved 0.6 mm of 12.7 m with the default).
+        let params = HsmParams { substep_rate: 240.0, drag_scale: 10.0, ..Default::default() };
         let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(150)).unwrap());
         let mut cpu = h.state_at_rest();
         let mut gpu =

@@ -3,7 +3,7 @@
 //! (and, where it is stiffer than the substep, held by the hold instead). So the method
 //! measures its own stems once, in still air without damping or drag, and scales their
 //! rates until each rings at its first mode from the wood,
-//! [`crate::physics::stem_frequencies`].
+//! [`crate::physics::stem_frequencies`], then its drag until the trunk leans as the beam.
 //!
 //! Scaling every rate and the hold by `s` scales every frequency of the dynamics by `√s`,
 //! so the stems are plucked as built and compared with their targets times the trunk's
@@ -21,6 +21,12 @@
 //! 3. The trunk again: stiffer side stems hold more of the crown's mass to it (and weigh
 //!    more on the rings they share with it), so its own clusters are scaled back to the
 //!    frequency of step 1.
+//! 4. The drag: a steady calm wind switched on at rest swings the trunk top to twice its
+//!    lean, which the final scale divides by `1 / ratio²`; every particle's drag is scaled
+//!    so that lean is the beam's under the same (sheltered) drag,
+//!    [`crate::physics::beam::drag_bend`]. Rigid clusters ring as their beam does once
+//!    scaled, but a spread load bends them otherwise: by 11× too little on the aspen (a
+//!    long trunk of short, thick segments), by 2× on the palm (its mass in the crown).
 
 use super::raw::kind;
 use super::{FIXED, Hsm};
@@ -51,6 +57,12 @@ const DROP: f32 = 0.85;
 /// slows by more than 8 times is left so.
 const AGAIN: f32 = 4.0;
 
+/// Wind speed of the static pluck, m/s (small: the bend is linear in the drag).
+const CALM: f32 = 1.0;
+
+/// Bounds of the factor on the drag that gives the calibrated trunk the beam's static bend.
+const LOAD_FACTOR: (f32, f32) = (1.0 / 64.0, 64.0);
+
 /// Speed a side stem is set moving at, m/s (small: the dynamics are linear in it).
 const SPEED: f32 = 0.01;
 
@@ -64,31 +76,56 @@ const STEM_FACTOR: (f32, f32) = (1.0 / 16.0, 16.0);
 /// after a step load. `None` without a substep rate, without a trunk cluster, or when no
 /// peak comes within `LONGEST` seconds.
 pub fn trunk_frequency(tree: &Tree, hsm: &Hsm) -> Option<f32> {
-    trunk_pluck(tree, hsm, LONGEST)
+    trunk_pluck(tree, hsm, LONGEST).map(|p| p.hz)
 }
 
-/// [`trunk_frequency`], giving up after `longest` seconds.
-fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<f32> {
+/// What a trunk pluck reads.
+struct Pluck {
+    /// The trunk's first-mode frequency, Hz.
+    hz: f32,
+    /// The trunk top's first peak, m, under `LOAD`.
+    peak: f32,
+}
+
+/// [`trunk_frequency`] and the first peak, giving up after `longest` seconds.
+fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<Pluck> {
+    pluck_under(tree, hsm, longest, None)
+}
+
+/// A trunk pluck under `LOAD` (`None`) or under the drag of a steady wind of `speed`
+/// m/s along x (quadratic, without the air's damping or reconfiguration: a step load).
+fn pluck_under(tree: &Tree, hsm: &Hsm, longest: f32, speed: Option<f32>) -> Option<Pluck> {
     let rate = hsm.params.substep_rate * hsm.layout.rate_scale.max(1.0).sqrt();
     if rate <= 0.0 || tree.stems.is_empty() {
         return None;
     }
     let ring = tip_ring(tree, hsm, 0)?;
     let mut state = hsm.state_at_rest();
-    for v in &mut state.velocity {
-        if v[3] != FIXED {
-            v[3] = 0.0;
+    if speed.is_none() {
+        // No drag (the velocity's w is the particle's drag factor).
+        for v in &mut state.velocity {
+            if v[3] != FIXED {
+                v[3] = 0.0;
+            }
         }
     }
     let h = 1.0 / rate;
     let mut step = hsm.step_params(0.0, h);
     step.gravity = [LOAD, 0.0, 0.0, 0.0];
     step.damping = 1.0;
+    let wind = speed.map(|speed| {
+        step.gravity = [0.0; 4];
+        (step.air, step.vogel_exponent, step.leaf_turbulence) = (0.0, 0.0, 0.0);
+        let field = crate::wind::WindField::Constant(crate::wind::Constant { direction: [1.0, 0.0, 0.0], speed });
+        crate::wind::WindScene { fields: vec![field] }.packed()
+    });
+    let (fields, waves) = wind.as_ref().map_or((&[][..], &[][..]), |w| (&w.fields[..], &w.waves[..]));
     let mut x: Vec<f32> = Vec::new();
     let (mut best, mut at) = (0.0f32, 0usize);
     for i in 0..(longest.min(LONGEST) * rate) as usize {
         step.time = (i + 1) as f32 * h;
-        hsm.substep_with(&[], &[], &mut state, step);
+        step.sample_wind = (i == 0) as u32;
+        hsm.substep_with(fields, waves, &mut state, step);
         let xi = ring.iter().map(|&p| state.displacement[p][0]).sum::<f32>() / ring.len() as f32;
         if !xi.is_finite() {
             return None;
@@ -97,7 +134,7 @@ fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<f32> {
         if xi > best {
             (best, at) = (xi, i);
         } else if best > 0.0 && xi < DROP * best {
-            return Some(0.5 / refine(&x, at, h));
+            return Some(Pluck { hz: 0.5 / refine(&x, at, h), peak: best });
         }
     }
     None
@@ -236,7 +273,7 @@ fn refine(x: &[f32], at: usize, h: f32) -> f32 {
 /// docs): scales the layout's rates in place. Does nothing when the trunk gives no peak.
 pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
     let target = hsm.layout.sway_hz * hsm.params.stiffness_scale.sqrt();
-    let Some(f0) = trunk_pluck(tree, hsm, FIRST / target) else {
+    let Some(Pluck { hz: f0, .. }) = trunk_pluck(tree, hsm, FIRST / target) else {
         return;
     };
     // Plucked as built, every frequency is `ratio` times what it will be once scaled.
@@ -258,11 +295,27 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
     }
     // Stiffer side stems load the trunk more: it is brought back to where it was.
     if deepest > 0
-        && let Some(f1) = trunk_pluck(tree, hsm, AGAIN / f0)
+        && let Some(Pluck { hz: f1, .. }) = trunk_pluck(tree, hsm, AGAIN / f0)
     {
         let mut factors = vec![1.0; tree.stems.len()];
         factors[0] = (f0 / f1).powi(2).clamp(STEM_FACTOR.0, STEM_FACTOR.1);
         hsm.layout.scale_stem_rates(tree, &factors);
+    }
+    // The drag's scale: the trunk top's static lean in a steady wind, the beam's over the
+    // clusters' (a chain of rigid clusters rings as its beam does but bends under a spread
+    // load otherwise). A step load swings a lone mode to twice its lean, and the final
+    // scale of the rates by `s` bends it `1 / s` as far.
+    if let Some(Pluck { peak, .. }) = pluck_under(tree, hsm, AGAIN / f0, Some(CALM)) {
+        let lean = 0.5 * peak * (f0 / target).powi(2) / hsm.params.drag_scale.max(f32::MIN_POSITIVE);
+        let p = &hsm.params;
+        let shelter = crate::physics::crown_shelter(tree, p.drag, p.leaf_drag);
+        let areas = crate::physics::beam::drag_areas(tree, p.drag, p.leaf_drag, shelter);
+        let pressure = 0.5 * crate::physics::AIR_DENSITY * CALM * CALM;
+        let beam = crate::physics::beam::drag_bend(tree, p.min_radius, &areas).tip[0] * pressure
+            / p.stiffness_scale.max(f32::MIN_POSITIVE);
+        if lean > 0.0 && beam > 0.0 && (lean * beam).is_finite() {
+            hsm.layout.scale_loads((beam / lean).clamp(LOAD_FACTOR.0, LOAD_FACTOR.1));
+        }
     }
     hsm.layout.scale_rates((target / f0).powi(2).clamp(1e-4, 1e4));
 }

@@ -38,6 +38,9 @@ pub struct HsmLayout {
     /// Factor on every segment and stem cluster's rate since they were derived from the
     /// wood (see [`super::HsmParams::calibrate`]); 1 as built.
     pub rate_scale: f32,
+    /// Factor on every particle's drag since it was derived from the air: the calibrated
+    /// trunk's static compliance over the beam's ([`super::calibrate`]); 1 as built.
+    pub load_scale: f32,
     /// The trunk's first-mode frequency from the wood, Hz ([`crate::physics::stem_frequencies`]).
     pub sway_hz: f32,
 }
@@ -99,6 +102,7 @@ impl HsmLayout {
                 segment_cluster: vec![NONE; s.len()],
                 max_children: 0,
                 rate_scale: 1.0,
+                load_scale: 1.0,
                 sway_hz: crate::physics::stem_frequencies(tree, params.min_radius).hz(0),
             },
             rings: Vec::with_capacity(total_clusters),
@@ -112,6 +116,9 @@ impl HsmLayout {
         let r_mech = crate::physics::mechanical_radii(tree, params.min_radius);
         // Each leaf's petiole swing, as the closed form's (phases unused).
         let petioles = crate::leaves::LeafFlutter::new(tree, 0);
+        // Leaves and side stems drag no more together than the crown as a body, as in the
+        // other methods; the trunk's bark is not sheltered.
+        let shelter = crate::physics::crown_shelter(tree, params.drag, params.leaf_drag);
         #[allow(clippy::needless_range_loop)] // i indexes every per-segment array of the tree
         'segments: for i in 0..s.len() {
             if b.layout.info.len() >= total_clusters {
@@ -127,7 +134,8 @@ impl HsmLayout {
             let floor = tree.wood.segment_mass(len, params.min_radius, params.min_radius);
             let m = s.mass[i].max(floor).max(1e-9) / own;
             let area = (s.radius_base[i].max(params.min_radius) + s.radius_tip[i].max(params.min_radius)) * len / own;
-            let kd = 0.5 * AIR_DENSITY * params.drag * params.drag_scale * area / m;
+            let sheltered = if tree.stems.level[s.stem[i] as usize] == 0 { 1.0 } else { shelter };
+            let kd = 0.5 * AIR_DENSITY * params.drag * params.drag_scale * sheltered * area / m;
             let slot_offset = slot_particles.len() as u32;
             let mut my_rings = Vec::with_capacity(rings);
             let parent_cluster =
@@ -193,7 +201,7 @@ impl HsmLayout {
                 let (w, h) = (l.width[leaf], l.length[leaf]);
                 let blade = std::f32::consts::FRAC_PI_4 * w * h;
                 let m = (blade * tree.wood.leaf_areal_density).max(1e-9) / n as f32;
-                let kd = 0.5 * AIR_DENSITY * params.leaf_drag * params.drag_scale * blade / n as f32 / m;
+                let kd = 0.5 * AIR_DENSITY * params.leaf_drag * params.drag_scale * shelter * blade / n as f32 / m;
                 let slot_offset = slot_particles.len() as u32;
                 let (centre, first) = b.nearest_ring(c, l.position[leaf]);
                 slot_particles.extend(first..first + k as u32);
@@ -412,6 +420,14 @@ impl HsmLayout {
         }
         path_bounds(&mut self.clusters);
         self.rate_scale *= s;
+    }
+
+    /// Multiplies every particle's drag factor by `s`.
+    pub fn scale_loads(&mut self, s: f32) {
+        for r in &mut self.rest {
+            r[3] *= s;
+        }
+        self.load_scale *= s;
     }
 
     /// Multiplies the rates of each stem's segment clusters and stem cluster by its entry of

@@ -301,7 +301,7 @@ impl Hsm {
             hold: self.hold(dt),
             reconfiguration_speed: p.reconfiguration_speed,
             vogel_exponent: p.vogel_exponent,
-            air: if p.drag_scale > 0.0 { p.air_damping / p.drag_scale } else { 1.0 },
+            air: if p.drag_scale > 0.0 { p.air_damping / (p.drag_scale * self.layout.load_scale) } else { 1.0 },
             sample_wind: 1,
             leaf_turbulence: p.leaf_turbulence * self.leaf_motion.crown_wind,
             flutter_onset: self.leaf_motion.flutter_onset / self.leaf_motion.crown_wind.max(f32::MIN_POSITIVE),

@@ -58,29 +58,27 @@ pub struct HsmParams {
     /// Drag coefficient of bark (a cylinder in cross-flow ≈ 1.0–1.2). Default 0.8.
     pub drag: f32,
     /// Drag coefficient per (one-sided) leaf area. Default 0.05: leaves shelter one
-    /// another (see [`crate::methods::akagi::AkagiParams::leaf_drag`]).
+    /// another (see [`crate::methods::akagi::AkagiParams::leaf_drag`]). Leaves and the bark
+    /// of side stems are sheltered by the crown as in the other methods
+    /// ([`crate::physics::crown_shelter`]); the trunk's bark is not.
     pub leaf_drag: f32,
-    /// Factor on every particle's drag, bark and leaves. Default 3.5: calibrated so HSM's
-    /// trunk answers the wind as the other methods' do. At the wood's frequency (see
-    /// [`Self::calibrate`]) shape matching's trunk is stiffer under drag than the beam (its
-    /// clusters move their particles as rigid bodies, and the hold adds inertia to short,
-    /// thick segments): with 1, the small aspen's trunk top bends 2.3 cm in a steady 12 m/s
-    /// wind against the beam's 16–20 cm in Zioma, Akagi and Skjermo, and 8 matches the
-    /// static bend but sways 4.5 % of the height in `gusty`. With 3.5 the aspen's size series
-    /// (7–21 m) sways 1.35–1.84 % in `gusty`, among the others' 1.26–2.41 % and within 2× of
-    /// each; with 3, 1.16–1.58 %, 2.08× under Zioma on the 21 m tree (`sylva fidelity --quick
-    /// --species quaking_aspen`). It scales the drag's load, not the air's damping (see
+    /// Factor on every particle's drag, bark and leaves, on top of the calibration's (see
+    /// [`Self::calibrate`]: with it the trunk top leans in steady wind as the beam does).
+    /// Default 0.85: at the beam's lean HSM's trunk answers gusts more than the others' do
+    /// (the aspen sways 2.6–2.7 % of its height in `gusty` with 1, 2.0× Akagi's 1.34 %),
+    /// and with 0.85 the aspen's size series (7–21 m) sways 1.99–2.12 %, among the others'
+    /// 1.26–2.41 % and at most 1.64× Akagi's (`sylva fidelity --quick --species
+    /// quaking_aspen`). It scales the drag's load, not the air's damping (see
     /// [`Self::air_damping`]).
     pub drag_scale: f32,
-    /// The air's damping, as a factor on that of the drag without [`Self::drag_scale`]: a
-    /// particle's drag is `kd |r| r` on the relative velocity `r = wind − (air_damping /
-    /// drag_scale) v`, so the load in still parts is the scaled drag's and the drag's change
-    /// with the particle's own velocity (`∂F/∂v`, the aerodynamic damping) is `air_damping`
-    /// times the unscaled drag's. Default 1.5: the scale stands in for the clusters' static
-    /// stiffness, not for more air. On the aspen's size series (7–21 m) ζ is then 0.09–0.16
-    /// at 15 m/s, rising with the wind at every size; with 3 (the scale on the damping too)
-    /// 0.17–0.27, past the field's 0.2, and with 1 at most 0.12 but no longer rising past
-    /// 10 m/s on three sizes (`sylva fidelity --quick --species quaking_aspen`).
+    /// The air's damping, as a factor on that of the drag without [`Self::drag_scale`] or the
+    /// calibration's scale: a particle's drag is `kd |r| r` on the relative velocity
+    /// `r = wind − (air_damping / scales) v`, so the load in still parts is the scaled drag's
+    /// and the drag's change with the particle's own velocity (`∂F/∂v`, the aerodynamic
+    /// damping) is `air_damping` times the sheltered drag's. Default 5: the aspen's crown
+    /// damped as before it was sheltered (1.5 times the unsheltered drag's, over its shelter
+    /// under these coefficients, 0.31); on its size series ζ is then 0.129–0.139 at 15 m/s
+    /// and rises with the wind at every size (same command).
     pub air_damping: f32,
     /// Speed around which bark and leaves streamline, m/s (see
     /// [`crate::physics::DragModel`]; default 5, as the other methods).
@@ -152,8 +150,8 @@ impl Default for HsmParams {
             damping_ratio: crate::physics::STRUCTURAL_DAMPING,
             drag: 0.8,
             leaf_drag: 0.05,
-            drag_scale: 3.5,
-            air_damping: 1.5,
+            drag_scale: 0.85,
+            air_damping: 5.0,
             reconfiguration_speed: crate::physics::DragModel::default().reconfiguration_speed,
             vogel_exponent: crate::physics::DragModel::default().vogel_exponent,
             gravity: 9.81,
