@@ -253,7 +253,9 @@ fn hsm_damping_is_in_the_field_range_and_rises_with_wind() {
 /// HSM's `drag_scale` (3) also tripled the air's damping, and its ζ passed 0.2 at 15 m/s on
 /// the 16 and 21 m aspens. The drag's scales (the calibration's and `drag_scale`) carry the
 /// load only: the lean in a steady wind is the same with the air's damping at its default
-/// or at the scales (±1 %), and the ring is damped less.
+/// or at the scales (±1 %), and the ring is damped less. At its default (`air_damping` 2)
+/// the trunk rings down at 15 m/s as the continuous beam's does (Skjermo's ζ, ±20 %;
+/// measured 0.066 against 0.069).
 #[test]
 fn hsm_drag_scale_scales_the_load_not_the_air_damping() {
     let t = small_aspen();
@@ -271,6 +273,9 @@ fn hsm_drag_scale_scales_the_load_not_the_air_damping() {
     );
     assert!((lean / lean_scaled - 1.0).abs() < 0.01, "lean {lean} m against {lean_scaled} m");
     assert!(z < 0.8 * z_scaled, "ζ {z} against {z_scaled} with the scales on the damping");
+    let (_, beam) = step_response(&Skjermo::new(&t, SkjermoParams::default()), &t, 15.0, 0.05);
+    println!("ζ at 15 m/s: HSM {z:.3}, the beam (Skjermo) {beam:.3}");
+    assert!((z / beam - 1.0).abs() <= 0.2, "HSM's ζ {z} against the beam's {beam} at 15 m/s");
 }
 
 /// HSM's calibration scales its drag so that the trunk leans as the beam: the palm (its mass

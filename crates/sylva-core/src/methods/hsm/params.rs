@@ -66,8 +66,8 @@ pub struct HsmParams {
     /// [`Self::calibrate`]: with it the trunk top leans in steady wind as the beam does).
     /// Default 0.85: at the beam's lean HSM's trunk answers gusts more than the others' do
     /// (the aspen sways 2.6–2.7 % of its height in `gusty` with 1, 2.0× Akagi's 1.34 %),
-    /// and with 0.85 the aspen's size series (7–21 m) sways 1.99–2.12 %, among the others'
-    /// 1.26–2.41 % and at most 1.64× Akagi's (`sylva fidelity --quick --species
+    /// and with 0.85 the aspen's size series (7–21 m) sways 2.05–2.20 %, among the others'
+    /// 1.26–2.41 % and at most 1.71× Akagi's (`sylva fidelity --quick --species
     /// quaking_aspen`). It scales the drag's load, not the air's damping (see
     /// [`Self::air_damping`]).
     pub drag_scale: f32,
@@ -75,10 +75,11 @@ pub struct HsmParams {
     /// calibration's scale: a particle's drag is `kd |r| r` on the relative velocity
     /// `r = wind − (air_damping / scales) v`, so the load in still parts is the scaled drag's
     /// and the drag's change with the particle's own velocity (`∂F/∂v`, the aerodynamic
-    /// damping) is `air_damping` times the sheltered drag's. Default 5: the aspen's crown
-    /// damped as before it was sheltered (1.5 times the unsheltered drag's, over its shelter
-    /// under these coefficients, 0.31); on its size series ζ is then 0.129–0.139 at 15 m/s
-    /// and rises with the wind at every size (same command).
+    /// damping) is `air_damping` times the sheltered drag's. Default 2: the trunk rings down
+    /// in wind as the continuous beam's (Skjermo's) does: on the aspen's size series ζ at
+    /// 15 m/s is 0.073–0.079 (Skjermo's 0.063–0.073), rising with the wind at every size, and
+    /// second-level tips keep 16–51 % of their motion above 1.5 Hz (same command). With 5 ζ
+    /// was 0.13–0.14 and the twigs of the 21 m tree kept only 9.9 % of theirs above 1.5 Hz.
     pub air_damping: f32,
     /// Speed around which bark and leaves streamline, m/s (see
     /// [`crate::physics::DragModel`]; default 5, as the other methods).
@@ -151,7 +152,7 @@ impl Default for HsmParams {
             drag: 0.8,
             leaf_drag: 0.05,
             drag_scale: 0.85,
-            air_damping: 5.0,
+            air_damping: 2.0,
             reconfiguration_speed: crate::physics::DragModel::default().reconfiguration_speed,
             vogel_exponent: crate::physics::DragModel::default().vogel_exponent,
             gravity: 9.81,
