@@ -284,7 +284,7 @@ fn hsm_drag_scale_scales_the_load_not_the_air_damping() {
 /// bends 11× less than its beam under a spread load. With `drag_scale` 1 the trunk top's
 /// mean lean in a steady 10 m/s wind is Skjermo's (the continuous beam's static bend under
 /// the same sheltered, streamlined drag) within ±25 % on the palm and on the small aspen
-/// (measured +8 % and +14 % on the full-size palm and aspen).
+/// (measured +9 % on the palm, 11.3 mm against 10.4 mm, and +13 % on the small aspen).
 #[test]
 fn hsm_calibrated_trunk_leans_as_the_beam_in_steady_wind() {
     for (name, t) in [("palm", species("palm", 1.0, 1)), ("small aspen", small_aspen())] {
@@ -826,14 +826,15 @@ fn zioma_twigs_along_the_wind_do_not_flip_as_it_turns() {
     }
 }
 
-/// Mean downwind displacement of the trunk top over seconds 10–20 of a steady wind.
+/// Mean downwind displacement of the trunk top over seconds 5–10 of a steady wind (the
+/// palm's HSM lean over seconds 5–10 and 10–20 agree to 0.1 mm of 11.3 mm).
 fn steady_bend<M: Method>(m: &M, t: &Tree, speed: f32) -> f32 {
     let top = trunk_top(t);
     let rest = t.segments.end(top);
     let dt = 1.0 / 60.0;
     let mut s = m.rest_state(t);
-    let series = record(m, t, &mut s, &constant(speed).packed(), dt, 1200, |p| p.end(t, top) - rest);
-    series[600..].iter().map(|d| d.x).sum::<f32>() / 600.0
+    let series = record(m, t, &mut s, &constant(speed).packed(), dt, 600, |p| p.end(t, top) - rest);
+    series[300..].iter().map(|d| d.x).sum::<f32>() / 300.0
 }
 
 /// Every method streamlines (Vogel 1989): well above the reconfiguration speed (5 m/s)
@@ -847,7 +848,8 @@ fn every_method_streamlines_in_strong_wind() {
     let d = sylva_core::physics::DragModel::default();
     let want = 4.0 * d.reconfiguration(24.0) / d.reconfiguration(12.0);
     fn ratio<M: Method>(t: &Tree, m: impl Fn(&Tree) -> M) -> f32 {
-        let (a, b) = (steady_bend(&m(t), t, 24.0), steady_bend(&m(t), t, 12.0));
+        let m = m(t);
+        let (a, b) = (steady_bend(&m, t, 24.0), steady_bend(&m, t, 12.0));
         println!("trunk top {:.3} m at 12 m/s, {:.3} m at 24 m/s", b, a);
         a / b
     }
