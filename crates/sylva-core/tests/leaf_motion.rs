@@ -63,11 +63,13 @@ fn median(v: &[f32]) -> f32 {
 /// and Skjermo flutter by the closed form, every probed leaf above its segment. HSM's leaves
 /// are its leaf clusters, swinging at their petioles' frequency in the air at their own
 /// scale (`leaf_air`), and a leaf pulls on the ring it shares with its segment as a petiole
-/// pulls on its twig: every probed leaf whose segment outweighs its blade peaks above that
-/// segment, and at least two in three of all. A twig tip lighter than its leaf (down to a
-/// hundredth of it here) shares the leaf's mode: both peak at one coupled frequency, or the
-/// tip rings at its own 10–20 Hz above the 12 Hz that leaves are capped at (measured: 35 of
-/// 48 above, every one of the 21 on segments heavier than their blades). Stiffer leaves do
+/// pulls on its twig: by beam theory a leaf turned by θ turns its segment by about
+/// `k_p / K` θ (`k_p` the petiole's swing stiffness, `K = E I / L` the segment's). Every
+/// probed leaf whose segment outweighs its blade, or turns by under 5 % of its swing, peaks
+/// above that segment, and at least two in three of all. A softer twig tip follows its
+/// leaf: both peak at one coupled frequency, or the tip rings at its own 10–20 Hz above the
+/// 12 Hz that leaves are capped at (measured: 35 of 48 above; all 25 whose segments turn by
+/// under 5 %, 10 of the 23 that turn by more, the first to fail at 5.3 %). Stiffer leaves do
 /// not part them: the tips follow the faster flutter (`leaf_stiffness` 2 and 4: 37 and 34).
 #[test]
 fn leaves_move_faster_than_their_segments_in_gusty_wind() {
@@ -108,26 +110,39 @@ fn leaves_move_faster_than_their_segments_in_gusty_wind() {
         assert!(median(&lp) > median(&sp), "{method}: leaf peak {} Hz, segments' {} Hz", median(&lp), median(&sp));
         if method == "hsm" {
             assert!(3 * above >= 2 * probes.len(), "{method}: {above}/{} leaves above their segments", probes.len());
-            let mut heavier = 0;
+            // Beam theory: a leaf turned by θ on its petiole turns its twig's segment by
+            // about `k_p / K` θ, `k_p` the petiole's swing stiffness and `K = E I / L` the
+            // segment's.
+            let radii = sylva_core::physics::mechanical_radii(&tree, sylva_core::physics::MIN_RADIUS);
+            let modes = sylva_core::physics::stem_frequencies(&tree, sylva_core::physics::MIN_RADIUS);
+            let (mut held, mut stiff) = (0, 0);
             for (k, &l) in probes.iter().enumerate() {
                 let seg = tree.leaves.segment[l] as usize;
-                let blade = tree.wood.leaf_areal_density
-                    * std::f32::consts::FRAC_PI_4
-                    * tree.leaves.width[l]
-                    * tree.leaves.length[l];
-                if tree.segments.mass[seg] >= blade {
-                    heavier += 1;
+                let (width, length) = (tree.leaves.width[l], tree.leaves.length[l]);
+                let rho_a = tree.wood.leaf_areal_density;
+                let blade = rho_a * std::f32::consts::FRAC_PI_4 * width * length;
+                let twig = modes.omega[tree.segments.stem[seg] as usize];
+                let petiole =
+                    sylva_core::leaves::leaf_constants(&tree.leaf_motion, width, length, rho_a, twig).stiffness;
+                let turn = petiole / tree.wood.segment_stiffness(tree.segments.length[seg], radii[seg]);
+                let heavier = tree.segments.mass[seg] >= blade;
+                stiff += usize::from(turn < 0.05);
+                if heavier || turn < 0.05 {
+                    held += 1;
                     assert!(
                         lp[k] > sp[k],
-                        "hsm: leaf {l} peaks at {} Hz, its segment ({} kg, blade {blade} kg) at {} Hz",
+                        "hsm: leaf {l} peaks at {} Hz, its segment ({} kg, blade {blade} kg; turned by {turn:.3} of the leaf's swing) at {} Hz",
                         lp[k],
                         tree.segments.mass[seg],
                         sp[k]
                     );
                 }
             }
-            println!("hsm: {heavier} of {} probed leaves on segments heavier than their blades", probes.len());
-            assert!(3 * heavier >= probes.len(), "hsm: {heavier} probed leaves on segments heavier than their blades");
+            println!(
+                "hsm: {held} of {} probed leaves on segments heavier than their blades or turned by under 5 % of their swing ({stiff} the latter)",
+                probes.len()
+            );
+            assert!(2 * held >= probes.len(), "hsm: {held} probed leaves held by their segments");
         } else {
             assert_eq!(above, probes.len(), "{method}: leaf peaks {lp:?}, segment peaks {sp:?}");
         }

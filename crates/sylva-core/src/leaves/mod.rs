@@ -203,6 +203,9 @@ pub struct LeafConstants {
     pub omega_twist: f32,
     /// `C_N A r / k`, 1/Pa.
     pub compliance: f32,
+    /// The petiole's swing stiffness `k = J ω²`, N·m/rad (`J` the blade's moment of inertia
+    /// about the attachment): the torque a leaf turned by one radian puts on its twig.
+    pub stiffness: f32,
 }
 
 /// Highest swing or twist frequency a leaf is given, Hz: a 60 Hz step samples the band's top
@@ -232,5 +235,6 @@ pub fn leaf_constants(p: &LeafMotion, width: f32, length: f32, rho_a: f32, twig_
         omega,
         omega_twist: (p.petiole_torsion * k / j_twist).sqrt().min(omega_max),
         compliance: p.normal_force * area * r / k,
+        stiffness: k,
     }
 }
