@@ -494,8 +494,10 @@ fn jittered_cases(extra: Vec<(String, HsmParams, Option<usize>)>, seed: u64) -> 
 /// The CPU's run pass (`hsm_particles_runs`: a ring's or a blade's particles eight to a
 /// register, their clusters read once) gives the bits of the per-particle pass that the WGSL
 /// twin mirrors, at every SIMD level: every preset with the default clusters (runs of two and
-/// four particles, partly filled registers) and Song's table sizes (rings of fourteen, blades
-/// of 42), from states a gusty wind has moved plus random noise on every free particle.
+/// four particles, partly filled registers), Song's table sizes (rings of fourteen, blades
+/// of 42) and rings that take no pull from their leaves (`leaf_reaction = false`: fewer
+/// clusters per ring particle), from states a gusty wind has moved plus random noise on
+/// every free particle.
 #[test]
 fn the_run_pass_gives_the_per_particle_pass_bits() {
     use sylva_core::methods::hsm::kernels::hsm_particles;
@@ -503,7 +505,8 @@ fn the_run_pass_gives_the_per_particle_pass_bits() {
     use sylva_core::simd::{Level, detected};
     println!("best SIMD level here: {:?}", detected());
     let fw = WindScene::resolve("gusty").unwrap().packed();
-    for (name, h, mut s) in jittered_cases(Vec::new(), 17) {
+    let unreacted = HsmParams { leaf_reaction: false, ..HsmParams::default() };
+    for (name, h, mut s) in jittered_cases(vec![("quaking_aspen".into(), unreacted, Some(1_500))], 17) {
         let l = &h.layout;
         let runs = HsmRuns::new(l);
         assert!(runs.len() < l.particle_count(), "{name}: no particles share a run");

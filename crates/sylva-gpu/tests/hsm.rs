@@ -54,11 +54,14 @@ fn hsm_one_substep_matches_from_random_states() {
     let wind = WindScene::resolve("gusty").unwrap();
     let fw = wind.packed();
     let mut rng = rand::rngs::StdRng::seed_from_u64(0x45_4d);
-    for (name, beta, fused) in
-        [("quaking_aspen", 0.0, false), ("ca_black_oak", 0.3, false), ("stochastic_bush", 0.0, true)]
-    {
+    for (name, beta, fused, leaf_reaction) in [
+        ("quaking_aspen", 0.0, false, true),
+        ("ca_black_oak", 0.3, false, true),
+        ("stochastic_bush", 0.0, true, true),
+        ("quaking_aspen", 0.0, true, false),
+    ] {
         let t = tree(name);
-        let params = HsmParams { substep_rate: 240.0, beta, fused, ..Default::default() };
+        let params = HsmParams { substep_rate: 240.0, beta, fused, leaf_reaction, ..Default::default() };
         let h = Hsm::from_layout(&t, params, HsmLayout::new(&t, &params, Some(3000)).unwrap());
         let state = random_state(&h, &mut rng);
         let mut gpu =
@@ -90,7 +93,10 @@ fn hsm_one_substep_matches_from_random_states() {
             let wb = Vec3::from_slice(&b.wind[..3]);
             assert!((wa - wb).length() <= 1e-4 * (1.0 + wa.length()), "{name}: cluster {c} wind {wa} vs {wb}");
         }
-        println!("hsm one substep {name:<16} β {beta} fused {fused}: worst difference {:.2e} × height", d / t.height());
+        println!(
+            "hsm one substep {name:<16} β {beta} fused {fused} leaf reaction {leaf_reaction}: worst difference {:.2e} × height",
+            d / t.height()
+        );
     }
 }
 

@@ -218,6 +218,15 @@ impl HsmLayout {
                     b.particle(l.position[leaf] + lq * local, m, kd, true, leaf_cluster);
                 }
                 slot_particles.extend(first_own..first_own + n as u32);
+                if !params.leaf_reaction {
+                    // The ring carries the blade's mass and drag (its particles share them).
+                    let (add, drag) = (m * n as f32 / k as f32, kd * m * n as f32 / k as f32);
+                    for p in first as usize..first as usize + k {
+                        let (m0, kd0) = (b.layout.mass[p], b.layout.rest[p][3]);
+                        b.layout.mass[p] = m0 + add;
+                        b.layout.rest[p][3] = (kd0 * m0 + drag) / (m0 + add);
+                    }
+                }
                 b.rings.push(vec![(centre, first)]);
                 b.layout.info.push(RawHsmClusterInfo {
                     kind: kind::LEAF,
@@ -228,6 +237,18 @@ impl HsmLayout {
                 parents.push(c);
                 let omega = petioles.leaves.get(leaf).map_or(0.0, |m| m.omega);
                 stiffness.push((omega * omega * params.leaf_stiffness, 0.0));
+            }
+        }
+        if !params.leaf_reaction {
+            // Rings that carry leaves weigh more: each segment's μ from the final masses.
+            for (c, (_, mu)) in stiffness.iter_mut().enumerate() {
+                if b.layout.info[c].kind == kind::SEGMENT {
+                    let ring = |f: u32| b.layout.mass[f as usize] * k as f32;
+                    let rings = &b.rings[c];
+                    let head = ring(rings[0].1);
+                    let rest: f32 = rings[1..].iter().map(|r| ring(r.1)).sum();
+                    *mu = head * rest / (head + rest);
+                }
             }
         }
         // Song's global level (Fig. 4): one more cluster per stem over all its segments'
@@ -349,19 +370,28 @@ impl HsmLayout {
             });
         }
         path_bounds(&mut clusters);
-        // Each particle's (cluster, slot) pairs, in cluster order.
+        // Each particle's (cluster, slot) pairs, in cluster order; without the leaves'
+        // reaction a ring takes no pull from its leaves' clusters.
+        let info = &b.layout.info;
+        let owner = &b.layout.owner;
+        let pulls = |c: usize, p: usize| params.leaf_reaction || info[c].kind != kind::LEAF || owner[p] == c as u32;
         let mut count = vec![0u32; n_particles + 1];
-        for s in &slots {
-            count[s.particle as usize + 1] += 1;
+        for (c, i) in info.iter().enumerate() {
+            for s in &slots[i.slot_offset as usize..(i.slot_offset + i.slot_count) as usize] {
+                count[s.particle as usize + 1] += u32::from(pulls(c, s.particle as usize));
+            }
         }
         for i in 0..n_particles {
             count[i + 1] += count[i];
         }
-        let mut member = vec![RawHsmMember { q: [0.0; 3], cluster: 0 }; slots.len()];
+        let mut member = vec![RawHsmMember { q: [0.0; 3], cluster: 0 }; count[n_particles] as usize];
         let mut fill = count.clone();
-        for (c, info) in b.layout.info.iter().enumerate() {
+        for (c, info) in info.iter().enumerate() {
             for sl in info.slot_offset..info.slot_offset + info.slot_count {
                 let p = slots[sl as usize].particle as usize;
+                if !pulls(c, p) {
+                    continue;
+                }
                 member[fill[p] as usize] = RawHsmMember { q: slots[sl as usize].q, cluster: c as u32 };
                 fill[p] += 1;
             }
