@@ -222,9 +222,9 @@ fn hurricane() -> Arc<PackedWind> {
 /// move. The closed form's leaves (Zioma, Akagi, Skjermo) through ten simulated minutes, then
 /// at rest at the next calm step (they follow the wind at their twig). HSM's leaf clusters
 /// through one minute, with and without their reaction on the twigs (its ten-minute
-/// hurricane, leaves included, is `hsm.rs`'s, on the
-/// stochastic bush), then every leaf back within 1° of rest within 30 s of calm (its
-/// leaves and twigs ring down with the structure's damping and the air's).
+/// hurricane, leaves included, is `hsm.rs`'s, on the stochastic bush), then every leaf back
+/// within 1° of rest within 30 s of calm (its leaves and twigs ring down with the
+/// structure's damping and the air's).
 fn hurricane_keeps_leaves_bounded_then_at_rest(method: &str) {
     let tree = aspen(0.05);
     let dt = 1.0f32 / 60.0;
