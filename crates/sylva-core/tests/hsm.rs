@@ -495,8 +495,8 @@ fn jittered_cases(extra: Vec<(String, HsmParams, Option<usize>)>, seed: u64) -> 
 /// register, their clusters read once) gives the bits of the per-particle pass that the WGSL
 /// twin mirrors, at every SIMD level: every preset with the default clusters (runs of two and
 /// four particles, partly filled registers), Song's table sizes (rings of fourteen, blades
-/// of 42) and rings that take no pull from their leaves (`leaf_reaction = false`: fewer
-/// clusters per ring particle), from states a gusty wind has moved plus random noise on
+/// of 42) and rings that take their leaves' pull (`leaf_reaction = true`: more clusters
+/// per ring particle), from states a gusty wind has moved plus random noise on
 /// every free particle.
 #[test]
 fn the_run_pass_gives_the_per_particle_pass_bits() {
@@ -505,8 +505,8 @@ fn the_run_pass_gives_the_per_particle_pass_bits() {
     use sylva_core::simd::{Level, detected};
     println!("best SIMD level here: {:?}", detected());
     let fw = WindScene::resolve("gusty").unwrap().packed();
-    let unreacted = HsmParams { leaf_reaction: false, ..HsmParams::default() };
-    for (name, h, mut s) in jittered_cases(vec![("quaking_aspen".into(), unreacted, Some(1_500))], 17) {
+    let reacted = HsmParams { leaf_reaction: true, ..HsmParams::default() };
+    for (name, h, mut s) in jittered_cases(vec![("quaking_aspen".into(), reacted, Some(1_500))], 17) {
         let l = &h.layout;
         let runs = HsmRuns::new(l);
         assert!(runs.len() < l.particle_count(), "{name}: no particles share a run");

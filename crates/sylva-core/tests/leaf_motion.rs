@@ -11,11 +11,12 @@ use sylva_core::pose::SeamPose;
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::{Constant, PackedWind, Turbulence, WindField, WindScene};
 
-/// Every method, and HSM with its leaves' swing not pulling on their twigs.
-const METHODS: [&str; 5] = ["zioma", "akagi", "skjermo", "hsm", HSM_UNREACTED];
+/// Every method, and HSM with its leaves' swing pulling on their twigs.
+const METHODS: [&str; 5] = ["zioma", "akagi", "skjermo", "hsm", HSM_REACTED];
 
-/// HSM without the leaves' reaction on their rings (`HsmParams::leaf_reaction`).
-const HSM_UNREACTED: &str = "hsm leaf_reaction = false";
+/// HSM with the leaves' reaction on their rings (`HsmParams::leaf_reaction`, Song's linked
+/// clusters).
+const HSM_REACTED: &str = "hsm leaf_reaction = true";
 
 /// The aspen at half size with `leaves` of its leaves (HSM simulates a cluster per leaf).
 fn aspen(leaves: f64) -> Arc<Tree> {
@@ -65,20 +66,22 @@ fn median(v: &[f32]) -> f32 {
 /// Twenty seconds of `gusty` at 60 Hz on the half-size aspen, 48 leaves probed: each
 /// method's leaves turn relative to their segments by at least 5° RMS, and the energy of
 /// that turn (the premultiplied spectrum's peak) lies above the segment's own. The series is
-/// the turn's angle, a magnitude: a flutter about the rest shows at twice its frequency. Zioma, Akagi
-/// and Skjermo flutter by the closed form, every probed leaf above its segment. HSM's leaves
-/// are its leaf clusters, swinging at their petioles' frequency in the air at their own
-/// scale (`leaf_air`), and a leaf pulls on the ring it shares with its segment as a petiole
-/// pulls on its twig: by beam theory a leaf turned by θ turns its segment by about
-/// `k_p / K` θ (`k_p` the petiole's swing stiffness, `K = E I / L` the segment's). Every
-/// probed leaf whose segment outweighs its blade, or turns by under 5 % of its swing, peaks
-/// above that segment, and at least two in three of all. A softer twig tip follows its
-/// leaf: both peak at one coupled frequency, or the tip rings at its own 10–20 Hz above the
-/// 12 Hz that leaves are capped at (measured: 35 of 48 above; all 25 whose segments turn by
-/// under 5 %, 10 of the 23 that turn by more, the first to fail at 5.3 %). Stiffer leaves do
-/// not part them: the tips follow the faster flutter (`leaf_stiffness` 2 and 4: 37 and 34).
-/// Without the leaves' reaction (`leaf_reaction = false`: a ring carries its leaves' mass
-/// and drag but not their swing) every probed leaf peaks above its segment.
+/// the turn's angle, a magnitude: a flutter about the rest shows at twice its frequency.
+/// Every probed leaf peaks above its segment in every method at its defaults: Zioma, Akagi
+/// and Skjermo flutter by the closed form; HSM's leaves are its leaf clusters, swinging at
+/// their petioles' frequency in the air at their own scale (`leaf_air`), on rings that carry
+/// their mass and drag but not their swing.
+///
+/// With the leaves' reaction (`leaf_reaction = true`) a leaf pulls on the ring it shares
+/// with its segment as a petiole pulls on its twig: by beam theory a leaf turned by θ turns
+/// its segment by about `k_p / K` θ (`k_p` the petiole's swing stiffness, `K = E I / L` the
+/// segment's). Every probed leaf whose segment outweighs its blade, or turns by under 5 % of
+/// its swing, peaks above that segment, and at least two in three of all. A softer twig tip
+/// follows its leaf: both peak at one coupled frequency, or the tip rings at its own 10–20 Hz
+/// above the 12 Hz that leaves are capped at (measured: 35 of 48 above; all 25 whose
+/// segments turn by under 5 %, 10 of the 23 that turn by more, the first to fail at 5.3 %).
+/// Stiffer leaves do not part them: the tips follow the faster flutter (`leaf_stiffness` 2
+/// and 4: 37 and 34).
 #[test]
 fn leaves_move_faster_than_their_segments_in_gusty_wind() {
     let tree = aspen(0.2);
@@ -116,7 +119,7 @@ fn leaves_move_faster_than_their_segments_in_gusty_wind() {
         );
         assert!(rms >= 5.0, "{method}: leaves turn {rms:.2}° RMS, under 5°");
         assert!(median(&lp) > median(&sp), "{method}: leaf peak {} Hz, segments' {} Hz", median(&lp), median(&sp));
-        if method == "hsm" {
+        if method == HSM_REACTED {
             assert!(3 * above >= 2 * probes.len(), "{method}: {above}/{} leaves above their segments", probes.len());
             // Beam theory: a leaf turned by θ on its petiole turns its twig's segment by
             // about `k_p / K` θ, `k_p` the petiole's swing stiffness and `K = E I / L` the
@@ -221,7 +224,7 @@ fn hurricane() -> Arc<PackedWind> {
 /// Hurricane at 60 Hz: every leaf rotation stays a finite unit quaternion and the leaves
 /// move. The closed form's leaves (Zioma, Akagi, Skjermo) through ten simulated minutes, then
 /// at rest at the next calm step (they follow the wind at their twig). HSM's leaf clusters
-/// through one minute, with and without their reaction on the twigs (its ten-minute
+/// through one minute, without and with their reaction on the twigs (its ten-minute
 /// hurricane, leaves included, is `hsm.rs`'s, on the stochastic bush), then every leaf back
 /// within 1° of rest within 30 s of calm (its leaves and twigs ring down with the
 /// structure's damping and the air's).
@@ -283,8 +286,8 @@ fn hsm_hurricane_keeps_leaves_bounded_then_at_rest() {
 }
 
 #[test]
-fn hsm_unreacted_hurricane_keeps_leaves_bounded_then_at_rest() {
-    hurricane_keeps_leaves_bounded_then_at_rest(HSM_UNREACTED);
+fn hsm_with_leaf_reaction_hurricane_keeps_leaves_bounded_then_at_rest() {
+    hurricane_keeps_leaves_bounded_then_at_rest(HSM_REACTED);
 }
 
 /// The same run on one thread and on four gives the same leaf rotations bit for bit.

@@ -49,16 +49,14 @@ pub struct HsmParams {
     /// HSM's leaves flutter about as much as the closed form's in `gusty` (`leaf_motion`
     /// tests). 0: leaves move only with the resolved wind.
     pub leaf_turbulence: f32,
-    /// A leaf's swing pulls back on its twig. Default true: a leaf cluster shares its ring
-    /// with its segment (Song's linked clusters carry force both ways), so a leaf turned by
-    /// θ turns its segment by about `k_p / K` θ (its petiole's swing stiffness over the
-    /// segment's `E I / L`), and a twig tip lighter than its leaf swings with it at one
-    /// coupled frequency. False: the ring moves its leaves but takes none of their swing; it
-    /// carries their mass and drag itself, as the closed-form methods' segments do, and every
-    /// leaf flutters above its twig. Its calibration then misses more: with the leaves' mass
-    /// on the twigs, the half-size aspen's trunk rings at 0.90 of its beam frequency (0.99
-    /// with the reaction), as [`super::calibrate`] brings the trunk back once after scaling
-    /// the side stems.
+    /// Whether a leaf's swing pulls back on its twig. Default false: the ring moves its
+    /// leaves and carries their mass and drag, as the closed-form methods' segments do, but
+    /// takes none of their swing, so every leaf flutters above its twig (`leaf_motion`'s
+    /// gusty test: 48 of 48 probed leaves of the half-size aspen). True: Song's linked
+    /// clusters carry force both ways, a leaf cluster sharing its ring with its segment, so
+    /// a leaf turned by θ turns its segment by about `k_p / K` θ (its petiole's swing
+    /// stiffness over the segment's `E I / L`), and a twig tip lighter than its leaf swings
+    /// with it at one coupled frequency (13 of the half-size aspen's 48 probed leaves).
     pub leaf_reaction: bool,
     /// Structural damping ratio ζ of the trunk's first mode: velocities are damped at the
     /// rate `c = 2 ζ ω₀` (`v *= e^{−c h}` each substep), ω₀ the trunk's frequency from the
@@ -159,7 +157,7 @@ impl Default for HsmParams {
             min_radius: 0.0015,
             leaf_stiffness: 1.0,
             leaf_turbulence: 0.3,
-            leaf_reaction: true,
+            leaf_reaction: false,
             damping_ratio: crate::physics::STRUCTURAL_DAMPING,
             drag: 0.8,
             leaf_drag: 0.05,
