@@ -43,6 +43,19 @@ impl From<&RawZiomaInstance> for Placement {
     }
 }
 
+/// The time the trunk's rate at `t` is differenced back to, and the span to `t + RATE_DT`:
+/// `RATE_DT` before `t`, but never past the change a ring starts at (before it the lean was
+/// the old wind's, which the ring's closed form does not know; differencing across it read
+/// the jump to the new wind's lean as a rate).
+fn rate_behind(ring: &Ring, t: f32) -> (f32, f32) {
+    let ringing = ring.bend != Vec3::ZERO || ring.rate != Vec3::ZERO;
+    if ringing && t >= ring.since && t - RATE_DT < ring.since {
+        (ring.since, RATE_DT + (t - ring.since))
+    } else {
+        (t - RATE_DT, 2.0 * RATE_DT)
+    }
+}
+
 /// One instance's frame values, ringing by `r`.
 pub fn zioma_frame(
     fields: &[RawField],
@@ -64,8 +77,8 @@ pub fn zioma_frame(
     let t = k.time;
     let (dir, noise) = lean(t);
     let a = noise.angles(t, seed);
-    let (tp, tm) = (t + RATE_DT, t - RATE_DT);
-    let rate = (lean(tp).1.angles(tp, seed)[0] - lean(tm).1.angles(tm, seed)[0]) / (2.0 * RATE_DT);
+    let (tp, (tm, span)) = (t + RATE_DT, rate_behind(&ring, t));
+    let rate = (lean(tp).1.angles(tp, seed)[0] - lean(tm).1.angles(tm, seed)[0]) / span;
     let (sin, cos) = i.yaw.sin_cos();
     RawZiomaFrame {
         wind_dir: dir.to_array(),

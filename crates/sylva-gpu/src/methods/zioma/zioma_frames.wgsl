@@ -180,14 +180,21 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let t = trunk.time;
     let now = lean(centre, ring, t, sc);
     let tp = t + RATE_DT;
-    let tm = t - RATE_DT;
+    // Never differenced back past the change a ring starts at (frames.rs, rate_behind).
+    var tm = t - RATE_DT;
+    var span = 2.0 * RATE_DT;
+    let ringing = any(ring.bend != vec3<f32>(0.0)) || any(ring.rate != vec3<f32>(0.0));
+    if (ringing && t >= ring.since && tm < ring.since) {
+        tm = ring.since;
+        span = RATE_DT + (t - ring.since);
+    }
     let ahead = trunk_noise_angles(lean(centre, ring, tp, sc).w, tp, seed).x;
     let behind = trunk_noise_angles(lean(centre, ring, tm, sc).w, tm, seed).x;
     var f: ZiomaFrame;
     f.wind_dir = now.xyz;
     f.time = t;
     f.trunk = trunk_noise_angles(now.w, t, seed);
-    f.trunk_rate = (ahead - behind) / (2.0 * RATE_DT);
+    f.trunk_rate = (ahead - behind) / span;
     f.lod = trunk.lod;
     f.amplitude = trunk.amplitude;
     f.max_bend = trunk.max_bend;
