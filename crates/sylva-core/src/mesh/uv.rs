@@ -38,7 +38,7 @@ impl MeshLayout {
     }
 
     /// Every leaf shape's rim of `leaf_sides` points, shape after shape, then the row an
-    /// unknown shape index gets ([`leaf_rims`]): the `leaf_rim` binding of `mesh_leaves`,
+    /// unknown shape index gets (`leaf_rims`): the `leaf_rim` binding of `mesh_leaves`,
     /// made once so that no kernel evaluates an outline per vertex and frame.
     pub fn leaf_rim_table(&self) -> Vec<Uv> {
         leaf_rims(self.params.leaf_sides).concat()

@@ -1,6 +1,6 @@
 //! A cluster's rotation R from its Apq (Müller, Bender, Chentanez & Macklin 2016, with a
 //! Newton step): [`extract_rotation`], the scalar reference and the twin of
-//! `extract_rotation` in `hsm.wgsl`, and [`extract_rotations_at`], sixteen clusters at a time
+//! `extract_rotation` in `hsm.wgsl`, and `extract_rotations_at`, sixteen clusters at a time
 //! in SIMD lanes with the same bits, which stage 1 runs on the CPU.
 
 use crate::simd::dispatch;
