@@ -369,8 +369,8 @@ fn zioma_instances_match_and_sway_independently() {
 }
 
 /// The frame kernel (`zioma_frames.wgsl`) against its CPU twin, on every wind preset, three
-/// trees, random instances (±300 m, any yaw), each with its own random ring (or none; a third
-/// of them begun within the last 10 ms) and random times up to 600 s.
+/// trees, random instances (±300 m, any yaw), each with its own random ring (or none; three
+/// in ten of the rest begun within the last 10 ms) and random times up to 600 s.
 /// Tolerances: the lean direction within 2e-4 rad, the trunk angles within 1e-5 rad and
 /// their rate within 1e-3 rad/s, each plus how far the CPU's own value moves when the time
 /// moves by two f32 ulps (as [`time_rounding_allowance`]: a GPU that fuses `ω t + φ` rounds
@@ -414,7 +414,7 @@ fn zioma_frames_match_their_cpu_twin() {
                         RawZiomaRing::from(&Ring {
                             bend: v(&mut rng, 0.1),
                             rate: v(&mut rng, 0.5),
-                            // A third begun within the rate's 10 ms reach, which it does
+                            // Three in ten begun within the rate's 10 ms reach, which it does
                             // not difference back past.
                             since: time
                                 - if rng.random_bool(0.3) {

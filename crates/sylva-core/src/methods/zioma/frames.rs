@@ -48,8 +48,7 @@ impl From<&RawZiomaInstance> for Placement {
 /// the old wind's, which the ring's closed form does not know; differencing across it read
 /// the jump to the new wind's lean as a rate).
 fn rate_behind(ring: &Ring, t: f32) -> (f32, f32) {
-    let ringing = ring.bend != Vec3::ZERO || ring.rate != Vec3::ZERO;
-    if ringing && t >= ring.since && t - RATE_DT < ring.since {
+    if ring.is_ringing() && t >= ring.since && t - RATE_DT < ring.since {
         (ring.since, RATE_DT + (t - ring.since))
     } else {
         (t - RATE_DT, 2.0 * RATE_DT)

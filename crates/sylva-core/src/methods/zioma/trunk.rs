@@ -189,6 +189,13 @@ pub struct Ring {
     pub zeta: f32,
 }
 
+impl Ring {
+    /// True when there is a ring (a bend or a rate to ring down), false for the default.
+    pub fn is_ringing(&self) -> bool {
+        self.bend != Vec3::ZERO || self.rate != Vec3::ZERO
+    }
+}
+
 /// Half-width of the central difference a bend's rate is taken over, s.
 const RATE_DT: f32 = 0.01;
 
@@ -196,7 +203,7 @@ impl TrunkModel {
     /// The ring's bend and rate at time `t` (none before its change).
     pub fn ring_at(&self, ring: &Ring, t: f32) -> (Vec3, Vec3) {
         let tau = t - ring.since;
-        if tau < 0.0 || (ring.bend == Vec3::ZERO && ring.rate == Vec3::ZERO) {
+        if tau < 0.0 || !ring.is_ringing() {
             return (Vec3::ZERO, Vec3::ZERO);
         }
         let w = std::f32::consts::TAU * self.natural_frequency;
