@@ -27,7 +27,7 @@ pub struct Limits {
     pub max_expression_depth: usize,
     /// Largest scene: segments and leaves summed over every tree and each of its instances
     /// (what the per-frame poses, meshes and simulation state grow with, about 1 KiB each).
-    /// Default 3 million: about 3 GiB; 64 weeping willows (12 million) peak at 12 GB.
+    /// Default 3 million: about 3 GiB; 64 weeping willows (13.4 million) would take about 13 GB.
     pub max_scene_elements: usize,
 }
 
