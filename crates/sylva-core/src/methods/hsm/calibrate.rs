@@ -50,8 +50,9 @@ const FIRST: f32 = 16.0;
 /// step load on a lone mode swings the top to twice its lean and back to rest, but a short,
 /// thick bole under a spreading crown hands its swing to the crown's branches: the black
 /// oak's top falls from its peak to 0.57 of it and then hovers about 0.7, and the willow's
-/// (with its source's split trunk) to 0.76; with 0.5 neither tree was calibrated. Every preset whose top does fall to half
-/// (no earlier dip of 15 %) is read at the same peak with either fraction.
+/// (with its source's split trunk) to 0.76; with 0.5 neither tree was calibrated. Every
+/// preset whose top does fall to half (no earlier dip of 15 %) is read at the same peak with
+/// either fraction.
 const DROP: f32 = 0.85;
 
 /// Longest trunk pluck after the side stems are scaled, in periods as built: a trunk that
