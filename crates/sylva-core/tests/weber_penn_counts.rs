@@ -102,3 +102,41 @@ fn splits_divide_children_instead_of_multiplying_them() {
     let ratio = s.stems_per_level[2] as f64 / plain.stems_per_level[2] as f64;
     assert!((0.8..1.25).contains(&ratio), "level-2 count changed by {ratio}");
 }
+
+/// A trunk that splits into three at its first joint (`base_splits` 2, eight segments of
+/// 1.25 m; radius `0.2 (1 − z)`): Weber–Penn's clones keep the radius there, 0.2 · 0.875 m
+/// each; with `split_shares_section` the three share its section, each `1/√3` of it. The
+/// trunk's DBH, 1.3 m up and so above the fork, is the three stems' together (`√Σd²`): the
+/// unforked trunk's when they share it, `√3` times it when each keeps it.
+#[test]
+fn a_split_shares_the_section_when_asked_and_the_dbh_sums_the_stems_above_a_fork() {
+    let forked =
+        SPECIES.replacen("curve_res = 4", "curve_res = 8", 1).replacen("levels = 4", "base_splits = 2\nlevels = 4", 1);
+    let grow = |share: bool| {
+        let text = if share {
+            forked.replacen("levels = 4", "split_shares_section = true\nlevels = 4", 1)
+        } else {
+            forked.clone()
+        };
+        SpeciesSource::from_text(&text, "fork.toml").unwrap().generate(1, &Default::default(), None).unwrap()
+    };
+    let at_fork = 0.2 * 0.875;
+    let at_breast = 2.0 * 0.2 * (1.0 - 0.13);
+    for (share, each, dbh) in [(false, at_fork, 3f32.sqrt() * at_breast), (true, at_fork / 3f32.sqrt(), at_breast)] {
+        let t = grow(share);
+        let (st, s) = (&t.stems, &t.segments);
+        let trunks: Vec<usize> = (0..st.len()).filter(|&k| st.level[k] == 0).collect();
+        assert_eq!(trunks.len(), 3, "sharing {share}: {} trunk stems", trunks.len());
+        assert!((s.radius_tip[0] - at_fork).abs() < 1e-5, "sharing {share}: below the fork {}", s.radius_tip[0]);
+        for &k in &trunks {
+            let first = st.first_segment[k] as usize + if k == 0 { 1 } else { 0 };
+            assert!(
+                (s.radius_base[first] - each).abs() < 1e-5,
+                "sharing {share}: stem {k} {} m, want {each}",
+                s.radius_base[first]
+            );
+        }
+        let got = t.dbh().unwrap();
+        assert!((got - dbh).abs() < 1e-4, "sharing {share}: DBH {got} m, want {dbh}");
+    }
+}

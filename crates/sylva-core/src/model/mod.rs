@@ -350,18 +350,46 @@ impl Tree {
     }
 
     /// Trunk diameter at breast height (1.3 m above the trunk's base, along its axis), m; for
-    /// a trunk shorter than that, its diameter at mid-length. `None` without stems.
+    /// a trunk shorter than that, its diameter at mid-length. Where the trunk has forked
+    /// below that height, the diameter of the section of its stems there together, `√Σd²`
+    /// (as multi-stemmed trees are measured). `None` without stems.
     pub fn dbh(&self) -> Option<f32> {
-        let (st, s) = (&self.stems, &self.segments);
+        let st = &self.stems;
         if st.is_empty() || st.segment_count[0] == 0 {
             return None;
         }
-        let (first, n) = (st.first_segment[0] as usize, st.segment_count[0] as usize);
         let target = BREAST_HEIGHT.min(0.5 * st.length[0]);
+        // Arc length from the trunk's base to where each of its stems (clones) starts.
+        let mut base = vec![f32::NAN; st.len()];
+        base[0] = 0.0;
+        let mut section = 0.0f32;
+        for k in 0..st.len() {
+            if k > 0 {
+                let p = st.parent[k] as usize;
+                if st.level[k] != 0 || p >= k || base[p].is_nan() {
+                    continue;
+                }
+                base[k] = base[p] + st.attach[k] * st.length[p];
+            }
+            if let Some(d) = self.diameter_along(k, target - base[k]) {
+                section += d * d;
+            }
+        }
+        Some(section.sqrt())
+    }
+
+    /// Diameter of stem `k` at arc length `at` from its base, m; `None` where `at` is off the
+    /// stem (stem 0 reads its tip's beyond its length).
+    fn diameter_along(&self, k: usize, at: f32) -> Option<f32> {
+        let (st, s) = (&self.stems, &self.segments);
+        let (first, n) = (st.first_segment[k] as usize, st.segment_count[k] as usize);
+        if n == 0 || at < 0.0 || (k > 0 && at >= st.length[k]) {
+            return None;
+        }
         let mut along = 0.0;
         for i in first..first + n {
-            if along + s.length[i] >= target || i + 1 == first + n {
-                let f = ((target - along) / s.length[i].max(1e-9)).clamp(0.0, 1.0);
+            if along + s.length[i] >= at || i + 1 == first + n {
+                let f = ((at - along) / s.length[i].max(1e-9)).clamp(0.0, 1.0);
                 return Some(2.0 * (s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * f));
             }
             along += s.length[i];

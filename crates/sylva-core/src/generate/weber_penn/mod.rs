@@ -3,8 +3,9 @@
 //! Follows the paper's algorithm: the trunk length and radius from Scale, Ratio and 0Scale;
 //! stems of `nCurveRes` segments bent by `nCurve`/`nCurveBack`/`nCurveV` and, from level 2,
 //! AttractionUp; splits (`0BaseSplits`, `nSegSplits`, fractions carried to the next
-//! segment); child counts, lengths, radii, down and rotate angles from the paper's formulas
-//! (ShapeRatio for the trunk's children); taper (`nTaper` 0–3) and Flare; pruning to the
+//! segment; the stems after a split share the branches and leaves, and with
+//! `split_shares_section` the section); child counts, lengths, radii, down and rotate
+//! angles from the paper's formulas (ShapeRatio for the trunk's children); taper (`nTaper` 0–3) and Flare; pruning to the
 //! envelope; leaves on the last level (a fan at the tip when `Leaves` < 0).
 //!
 //! Children of a stem sit at evenly spaced offsets: child `i` of `N` at
@@ -273,7 +274,15 @@ impl Gen<'_> {
             }
             let me = b.add_stem(spec.parent, spec.level as u8);
             for s in 0..nseg {
-                b.push_segment(me, t.points[s], t.points[s + 1], t.frames[s], t.radii[s], t.radii[s + 1]);
+                let share = if self.p.split_shares_section { t.density[s].sqrt() } else { 1.0 };
+                b.push_segment(
+                    me,
+                    t.points[s],
+                    t.points[s + 1],
+                    t.frames[s],
+                    share * t.radii[s],
+                    share * t.radii[s + 1],
+                );
             }
             // Clones continue the stem from the split.
             for (j, (local, frames, err)) in t.splits.iter().enumerate() {
@@ -416,7 +425,8 @@ impl Gen<'_> {
                 length_max * (length - 0.6 * offset)
             };
             length_child = length_child.max(0.0);
-            let parent_r = self.radius_at(level, spec.radius, length, offset / length);
+            let share = if p.split_shares_section { t.density[local].sqrt() } else { 1.0 };
+            let parent_r = share * self.radius_at(level, spec.radius, length, offset / length);
             let radius = (spec.radius * (length_child / length).powf(p.ratio_power)).min(parent_r);
             let down = if lc.down_angle_v >= 0.0 {
                 lc.down_angle + rng.var(lc.down_angle_v)

@@ -121,6 +121,12 @@ pub struct WeberPennParams {
     /// 0BaseSplits: splits at the base of the trunk's first segment.
     #[serde(default)]
     pub base_splits: u32,
+    /// Whether a split shares the stem's section among the stems it makes, as it shares their
+    /// branches and leaves: each of `k + 1` keeps `1/(k + 1)` of the area, its radius
+    /// `1/√(k + 1)` (Leonardo's rule, `Σd²` kept across a fork; Eloy 2011 finds the exponent
+    /// 1.8–2.3 in measured trees). Default false: each keeps the full radius (Weber & Penn).
+    #[serde(default)]
+    pub split_shares_section: bool,
     /// AttractionUp: upward (negative: downward) curving of level ≥ 2 stems.
     #[serde(default)]
     pub attraction_up: f64,
