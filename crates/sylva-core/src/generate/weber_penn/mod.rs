@@ -5,8 +5,9 @@
 //! AttractionUp; splits (`0BaseSplits`, `nSegSplits`, fractions carried to the next
 //! segment; the stems after a split share the branches and leaves, and with
 //! `split_shares_section` the section); child counts, lengths, radii, down and rotate
-//! angles from the paper's formulas (ShapeRatio for the trunk's children); taper (`nTaper` 0–3) and Flare; pruning to the
-//! envelope; leaves on the last level (a fan at the tip when `Leaves` < 0).
+//! angles from the paper's formulas (ShapeRatio for the trunk's children); taper (`nTaper`
+//! 0–3) and Flare; pruning to the envelope; leaves on the last level (a fan at the tip when
+//! `Leaves` < 0).
 //!
 //! Children of a stem sit at evenly spaced offsets: child `i` of `N` at
 //! `lo + (hi − lo)(i + ½)/N` along the stem's branching range (`BaseSize·Scale` to the tip for
