@@ -22,12 +22,13 @@
 //!    more on the rings they share with it), so its own clusters are scaled back to the
 //!    frequency of step 1, and again while it is more than 2 % off and each pass at least
 //!    halves what is left (at most three passes).
-//! 4. The drag: a steady calm wind switched on at rest swings the trunk top to twice its
-//!    lean, which the final scale divides by `1 / ratio²`; every particle's drag is scaled
-//!    so that lean is the beam's under the same (sheltered) drag,
-//!    [`crate::physics::beam::drag_bend`]. Rigid clusters ring as their beam does once
-//!    scaled, but a spread load bends them otherwise: by 11× too little on the aspen (a
-//!    long trunk of short, thick segments), by 2× on the palm (its mass in the crown).
+//! 4. The drag: a steady calm wind switched on at rest swings the trunk top about its
+//!    lean, its mean over two periods of the trunk (`LEAN_PERIODS`), which the final scale
+//!    divides by `1 / ratio²`; every particle's drag is scaled so that lean is the beam's
+//!    under the same (sheltered) drag, [`crate::physics::beam::drag_bend`]. Rigid clusters
+//!    ring as their beam does once scaled, but a spread load bends them otherwise: by 11×
+//!    too little on the aspen (a long trunk of short, thick segments), by 2× on the palm
+//!    (its mass in the crown).
 
 use super::raw::kind;
 use super::{FIXED, Hsm};
@@ -71,6 +72,11 @@ const TRUNK_TOLERANCE: f32 = 0.02;
 /// Wind speed of the static pluck, m/s (small: the bend is linear in the drag).
 const CALM: f32 = 1.0;
 
+/// Length of the static pluck in periods of the trunk as built: the mean of `1 − cos ωt`
+/// over two periods of the trunk's mode is its lean, and a quicker mode's swing averages to
+/// within `1 / (4π)` of it.
+const LEAN_PERIODS: f32 = 2.0;
+
 /// Bounds of the factor on the drag that gives the calibrated trunk the beam's static bend.
 const LOAD_FACTOR: (f32, f32) = (1.0 / 64.0, 64.0);
 
@@ -87,25 +93,48 @@ const STEM_FACTOR: (f32, f32) = (1.0 / 16.0, 16.0);
 /// after a step load. `None` without a substep rate, without a trunk cluster, or when no
 /// peak comes within `LONGEST` seconds.
 pub fn trunk_frequency(tree: &Tree, hsm: &Hsm) -> Option<f32> {
-    trunk_pluck(tree, hsm, LONGEST).map(|p| p.hz)
+    trunk_pluck(tree, hsm, LONGEST)
 }
 
-/// What a trunk pluck reads.
-struct Pluck {
-    /// The trunk's first-mode frequency, Hz.
-    hz: f32,
-    /// The trunk top's first peak, m, under `LOAD`.
-    peak: f32,
+/// [`trunk_frequency`], giving up after `longest` seconds.
+fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<f32> {
+    let (mut best, mut at) = (0.0f32, 0usize);
+    trunk_run(tree, hsm, longest, None, |x, h| {
+        let (i, xi) = (x.len() - 1, x[x.len() - 1]);
+        if xi > best {
+            (best, at) = (xi, i);
+        } else if best > 0.0 && xi < DROP * best {
+            return Some(0.5 / refine(x, at, h));
+        }
+        None
+    })
 }
 
-/// [`trunk_frequency`] and the first peak, giving up after `longest` seconds.
-fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<Pluck> {
-    pluck_under(tree, hsm, longest, None)
+/// The trunk top's static lean under the drag of a steady wind of `speed` m/s along x, m:
+/// its mean displacement over `window` seconds from rest (quadratic drag, without the air's
+/// damping or reconfiguration: a step load, undamped). A lone mode swings about its lean
+/// as `1 − cos ωt`, whose mean over whole periods is the lean; the first peak, twice the
+/// lean for a lone mode, is a crown's own quicker swing where the trunk hands its load to
+/// heavy leaders (the black oak's sapling with forks that share the section: a tenth of its
+/// lean).
+fn static_lean(tree: &Tree, hsm: &Hsm, window: f32, speed: f32) -> Option<f32> {
+    trunk_run(tree, hsm, window, Some(speed), |x, h| {
+        ((x.len() + 1) as f32 * h > window).then(|| x.iter().map(|&v| v as f64).sum::<f64>() as f32 / x.len() as f32)
+    })
 }
 
-/// A trunk pluck under `LOAD` (`None`) or under the drag of a steady wind of `speed`
-/// m/s along x (quadratic, without the air's damping or reconfiguration: a step load).
-fn pluck_under(tree: &Tree, hsm: &Hsm, longest: f32, speed: Option<f32>) -> Option<Pluck> {
+/// Steps `hsm` from rest under `LOAD` (`speed` `None`) or under the drag of a steady wind of
+/// `speed` m/s along x, for at most `longest` seconds, handing the trunk top ring's mean x
+/// displacement so far (one entry per substep) and the substep to `read` after each substep
+/// until it answers. `None` without a substep rate, without a trunk cluster, on a
+/// non-finite displacement, or when `read` has not answered in time.
+fn trunk_run<T>(
+    tree: &Tree,
+    hsm: &Hsm,
+    longest: f32,
+    speed: Option<f32>,
+    mut read: impl FnMut(&[f32], f32) -> Option<T>,
+) -> Option<T> {
     let rate = hsm.params.substep_rate * hsm.layout.rate_scale.max(1.0).sqrt();
     if rate <= 0.0 || tree.stems.is_empty() {
         return None;
@@ -132,7 +161,6 @@ fn pluck_under(tree: &Tree, hsm: &Hsm, longest: f32, speed: Option<f32>) -> Opti
     });
     let (fields, waves) = wind.as_ref().map_or((&[][..], &[][..]), |w| (&w.fields[..], &w.waves[..]));
     let mut x: Vec<f32> = Vec::new();
-    let (mut best, mut at) = (0.0f32, 0usize);
     for i in 0..(longest.min(LONGEST) * rate) as usize {
         step.time = (i + 1) as f32 * h;
         step.sample_wind = (i == 0) as u32;
@@ -142,10 +170,8 @@ fn pluck_under(tree: &Tree, hsm: &Hsm, longest: f32, speed: Option<f32>) -> Opti
             return None;
         }
         x.push(xi);
-        if xi > best {
-            (best, at) = (xi, i);
-        } else if best > 0.0 && xi < DROP * best {
-            return Some(Pluck { hz: 0.5 / refine(&x, at, h), peak: best });
+        if let Some(v) = read(&x, h) {
+            return Some(v);
         }
     }
     None
@@ -284,7 +310,7 @@ fn refine(x: &[f32], at: usize, h: f32) -> f32 {
 /// docs): scales the layout's rates in place. Does nothing when the trunk gives no peak.
 pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
     let target = hsm.layout.sway_hz * hsm.params.stiffness_scale.sqrt();
-    let Some(Pluck { hz: f0, .. }) = trunk_pluck(tree, hsm, FIRST / target) else {
+    let Some(f0) = trunk_pluck(tree, hsm, FIRST / target) else {
         return;
     };
     // Plucked as built, every frequency is `ratio` times what it will be once scaled.
@@ -311,7 +337,7 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
         let mut factors = vec![1.0; tree.stems.len()];
         let mut off = f32::INFINITY;
         for pass in 0..TRUNK_PASSES {
-            let Some(Pluck { hz: f1, .. }) = trunk_pluck(tree, hsm, AGAIN / f0) else {
+            let Some(f1) = trunk_pluck(tree, hsm, AGAIN / f0) else {
                 break;
             };
             let now = (f1 / f0 - 1.0).abs();
@@ -325,10 +351,9 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
     }
     // The drag's scale: the trunk top's static lean in a steady wind, the beam's over the
     // clusters' (a chain of rigid clusters rings as its beam does but bends under a spread
-    // load otherwise). A step load swings a lone mode to twice its lean, and the final
-    // scale of the rates by `s` bends it `1 / s` as far.
-    if let Some(Pluck { peak, .. }) = pluck_under(tree, hsm, AGAIN / f0, Some(CALM)) {
-        let lean = 0.5 * peak * (f0 / target).powi(2) / hsm.params.drag_scale.max(f32::MIN_POSITIVE);
+    // load otherwise). The final scale of the rates by `s` bends it `1 / s` as far.
+    if let Some(mean) = static_lean(tree, hsm, LEAN_PERIODS / f0, CALM) {
+        let lean = mean * (f0 / target).powi(2) / hsm.params.drag_scale.max(f32::MIN_POSITIVE);
         let p = &hsm.params;
         let shelter = crate::physics::crown_shelter(tree, p.drag, p.leaf_drag);
         let areas = crate::physics::beam::drag_areas(tree, p.drag, p.leaf_drag, shelter);
