@@ -115,8 +115,8 @@ fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<f32> {
 /// damping or reconfiguration: a step load, undamped). A lone mode swings about its lean
 /// as `1 − cos ωt`, whose mean over whole periods is the lean; the first peak, twice the
 /// lean for a lone mode, is a crown's own quicker swing where the trunk hands its load to
-/// heavy leaders (the black oak's sapling with forks that share the section: a tenth of its
-/// lean).
+/// heavy leaders (on the black oak's sapling with forks that share the section, half that
+/// peak was a 194th of the lean).
 fn static_lean(tree: &Tree, hsm: &Hsm, window: f32, speed: f32) -> Option<f32> {
     trunk_run(tree, hsm, window, Some(speed), |x, h| {
         ((x.len() + 1) as f32 * h > window).then(|| x.iter().map(|&v| v as f64).sum::<f64>() as f32 / x.len() as f32)
