@@ -326,19 +326,39 @@ fn hsm_drag_is_calibrated_on_a_trunk_that_hands_its_load_to_heavy_leaders() {
         p.split_shares_section = true;
         p.ratio = 0.019;
     });
-    let m = hsm(&t);
+    let (lean, beam) = hsm_early_lean("oak sapling", &t);
+    assert!(beam > 0.0 && (0.5..=2.0).contains(&(lean / beam)), "HSM {lean} %, beam {beam} %");
+}
+
+/// HSM's mean lean from 2.5 to 5 s in a steady 6 m/s wind from rest and the beam's static
+/// bend, % of the height (printed with the drag's scale).
+fn hsm_early_lean(name: &str, t: &Tree) -> (f32, f32) {
+    let m = hsm(t);
     let wind = constant(6.0).packed();
-    let top = trunk_top(&t);
-    let mut s = m.rest_state(&t);
-    let series = record(&m, &t, &mut s, &wind, 1.0 / 60.0, 300, |p| p.end(&t, top) - t.segments.end(top));
+    let top = trunk_top(t);
+    let mut s = m.rest_state(t);
+    let series = record(&m, t, &mut s, &wind, 1.0 / 60.0, 300, |p| p.end(t, top) - t.segments.end(top));
     let lean = 100.0 * series[150..].iter().map(|d| d.x).sum::<f32>() / 150.0 / t.height();
-    let beam = lean_at(&t, &wind);
+    let beam = lean_at(t, &wind);
     println!(
-        "oak sapling, H {:.2} m: HSM leans {lean:.2} %, the beam {beam:.2} % (drag scaled {:.2}×)",
+        "{name}, H {:.2} m: HSM leans {lean:.2} %, the beam {beam:.2} % (drag scaled {:.2}×)",
         t.height(),
         m.layout.load_scale
     );
-    assert!(beam > 0.0 && (0.5..=2.0).contains(&(lean / beam)), "HSM {lean} %, beam {beam} %");
+    (lean, beam)
+}
+
+/// HSM scales its drag so the trunk's end leans as the beam where the tree is drawn: in the
+/// pose, each segment turned by its cluster's rotation. Read at the particles of the trunk's
+/// tail ring instead, which clusters also move across the axis without turning, the black
+/// oak's sapling (the preset, seed 1: 2 m, forks that share the section) leaned 1.2–1.6 times
+/// as far as it is drawn, and the drawn tree leaned 0.65 of the beam from 2.5 to 5 s in a
+/// steady 6 m/s wind (2.04 against 3.13 %) and 0.55 from 10 to 20 s. HSM's drawn mean lean
+/// from 2.5 to 5 s must lie within 4/3 of the beam's static bend (measured 2.78 %, 0.89).
+#[test]
+fn hsm_drag_is_calibrated_on_the_trunk_as_drawn_not_on_its_particles() {
+    let (lean, beam) = hsm_early_lean("oak sapling (preset)", &species("ca_black_oak", 1.0, 1));
+    assert!(beam > 0.0 && (0.75..=4.0 / 3.0).contains(&(lean / beam)), "HSM {lean} %, beam {beam} %");
 }
 
 /// One method's minute in the `gusty` preset on the aspen (12 m), the first 10 s not read.

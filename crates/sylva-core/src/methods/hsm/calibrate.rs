@@ -22,18 +22,18 @@
 //!    more on the rings they share with it), so its own clusters are scaled back to the
 //!    frequency of step 1, and again while it is more than 2 % off and each pass at least
 //!    halves what is left (at most three passes).
-//! 4. The drag: a steady calm wind switched on at rest swings the trunk top about its
-//!    lean, its mean over two periods of the trunk (`LEAN_PERIODS`), which the final scale
-//!    divides by `1 / ratio²`; every particle's drag is scaled so that lean is the beam's
-//!    under the same (sheltered) drag, [`crate::physics::beam::drag_bend`]. Rigid clusters
-//!    ring as their beam does once scaled, but a spread load bends them otherwise: by 11×
-//!    too little on the aspen (a long trunk of short, thick segments), by 2× on the palm
-//!    (its mass in the crown).
+//! 4. The drag: a steady calm wind switched on at rest swings the trunk's end in the pose,
+//!    where the tree is drawn, about its lean, its mean over two periods of the trunk
+//!    (`LEAN_PERIODS`), which the final scale divides by `1 / ratio²`; every particle's
+//!    drag is scaled so that lean is the beam's under the same (sheltered) drag,
+//!    [`crate::physics::beam::drag_bend`]. Rigid clusters ring as their beam does once
+//!    scaled, but a spread load bends them otherwise: by 11× too little on the aspen (a long
+//!    trunk of short, thick segments), by 2× on the palm (its mass in the crown).
 
 use super::raw::kind;
 use super::{FIXED, Hsm};
 use crate::model::{NONE, Tree};
-use glam::Vec3;
+use glam::{Quat, Vec3};
 
 /// Lateral acceleration of the pluck, m/s² (the dynamics are linear in it but for large
 /// bends; 1 m/s² bends a tree by a small fraction of the wind's).
@@ -99,7 +99,7 @@ pub fn trunk_frequency(tree: &Tree, hsm: &Hsm) -> Option<f32> {
 /// [`trunk_frequency`], giving up after `longest` seconds.
 fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<f32> {
     let (mut best, mut at) = (0.0f32, 0usize);
-    trunk_run(tree, hsm, longest, None, |x, h| {
+    trunk_run(tree, hsm, longest, None, Top::Ring, |x, h| {
         let (i, xi) = (x.len() - 1, x[x.len() - 1]);
         if xi > best {
             (best, at) = (xi, i);
@@ -111,28 +111,64 @@ fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<f32> {
 }
 
 /// The trunk top's static lean under the drag of a steady wind of `speed` m/s along x, m:
-/// its mean displacement over `window` seconds from rest (quadratic drag, without the air's
-/// damping or reconfiguration: a step load, undamped). A lone mode swings about its lean
-/// as `1 − cos ωt`, whose mean over whole periods is the lean; the first peak, twice the
-/// lean for a lone mode, is a crown's own quicker swing where the trunk hands its load to
-/// heavy leaders (on the black oak's sapling with forks that share the section, half that
-/// peak was a 194th of the lean).
+/// the mean displacement of its end in the pose ([`Top::Pose`]) over `window` seconds from
+/// rest (quadratic drag, without the air's damping or reconfiguration: a step load,
+/// undamped). A lone mode swings about its lean as `1 − cos ωt`, whose mean over whole
+/// periods is the lean; the first peak, twice the lean for a lone mode, is a crown's own
+/// quicker swing where the trunk hands its load to heavy leaders (on the black oak's sapling
+/// with forks that share the section, half that peak was a 194th of the lean).
 fn static_lean(tree: &Tree, hsm: &Hsm, window: f32, speed: f32) -> Option<f32> {
-    trunk_run(tree, hsm, window, Some(speed), |x, h| {
+    trunk_run(tree, hsm, window, Some(speed), Top::Pose, |x, h| {
         ((x.len() + 1) as f32 * h > window).then(|| x.iter().map(|&v| v as f64).sum::<f64>() as f32 / x.len() as f32)
     })
 }
 
+/// Where a trunk run reads the trunk top's x displacement.
+#[derive(Clone, Copy)]
+enum Top {
+    /// The mean of the particles of the tail ring of the trunk's last cluster.
+    Ring,
+    /// The end of the trunk's last segment in the pose, each segment from the root turned by
+    /// its cluster's rotation ([`Method::pose`](crate::methods::Method::pose)): where the
+    /// tree is drawn. Clusters also move their particles across the axis without turning:
+    /// on the black oak's sapling (forks that share the section) the ring leans 1.2–1.6
+    /// times as far as the pose in a steady wind, and a drag scaled on the ring left the drawn
+    /// tree leaning 0.55 of its beam (the other presets' drag scales moved 2–15 %).
+    Pose,
+}
+
+/// Each segment from the root to the trunk's end with a cluster, and its vector at rest to
+/// the next joint on the way (the trunk's end for the last): the pose puts the end at
+/// `Σ (R − 1) v` from rest.
+fn trunk_chain(tree: &Tree, hsm: &Hsm) -> Vec<(usize, Vec3)> {
+    let s = &tree.segments;
+    let mut i = (tree.stems.first_segment[0] + tree.stems.segment_count[0] - 1) as usize;
+    let mut next = s.end(i);
+    let mut chain = Vec::new();
+    loop {
+        let c = hsm.layout.segment_cluster[i];
+        if c != NONE {
+            chain.push((c as usize, next - s.start[i]));
+        }
+        next = s.start[i];
+        match s.parent[i] {
+            NONE => return chain,
+            p => i = p as usize,
+        }
+    }
+}
+
 /// Steps `hsm` from rest under `LOAD` (`speed` `None`) or under the drag of a steady wind of
-/// `speed` m/s along x, for at most `longest` seconds, handing the trunk top ring's mean x
-/// displacement so far (one entry per substep) and the substep to `read` after each substep
-/// until it answers. `None` without a substep rate, without a trunk cluster, on a
-/// non-finite displacement, or when `read` has not answered in time.
+/// `speed` m/s along x, for at most `longest` seconds, handing the trunk top's x
+/// displacement so far, read `at` it (one entry per substep), and the substep to `read`
+/// after each substep until it answers. `None` without a substep rate, without a trunk
+/// cluster, on a non-finite displacement, or when `read` has not answered in time.
 fn trunk_run<T>(
     tree: &Tree,
     hsm: &Hsm,
     longest: f32,
     speed: Option<f32>,
+    at: Top,
     mut read: impl FnMut(&[f32], f32) -> Option<T>,
 ) -> Option<T> {
     let rate = hsm.params.substep_rate * hsm.layout.rate_scale.max(1.0).sqrt();
@@ -140,6 +176,7 @@ fn trunk_run<T>(
         return None;
     }
     let ring = tip_ring(tree, hsm, 0)?;
+    let chain = trunk_chain(tree, hsm);
     let mut state = hsm.state_at_rest();
     if speed.is_none() {
         // No drag (the velocity's w is the particle's drag factor).
@@ -165,7 +202,13 @@ fn trunk_run<T>(
         step.time = (i + 1) as f32 * h;
         step.sample_wind = (i == 0) as u32;
         hsm.substep_with(fields, waves, &mut state, step);
-        let xi = ring.iter().map(|&p| state.displacement[p][0]).sum::<f32>() / ring.len() as f32;
+        let xi = match at {
+            Top::Ring => ring.iter().map(|&p| state.displacement[p][0]).sum::<f32>() / ring.len() as f32,
+            Top::Pose => {
+                let turn = |&(c, v): &(usize, Vec3)| (Quat::from_array(state.clusters[c].rotation) * v - v).x;
+                chain.iter().map(turn).sum::<f32>()
+            }
+        };
         if !xi.is_finite() {
             return None;
         }
