@@ -12,8 +12,9 @@
 //!    and the air's damping of turning about it, `Γ = Σ γ r²`.
 //! 3. **Rotation** (`akagi_integrate`): each joint is a spring `k = E·I/ℓ` of its segment's
 //!    section (never thinner than what carries its leaves, [`crate::physics::section_floor`])
-//!    and length — in a chain, these bend as the
-//!    beam does under the propagated moments. Its inertia is modal, `J = k/ω²` with ω its stem's first-mode
+//!    and length — in a chain, these bend under the propagated moments as a beam stepped at
+//!    each segment's base section, stiffer than the tapered beam where a segment tapers. Its
+//!    inertia is modal, `J = k/ω²` with ω its stem's first-mode
 //!    frequency from the wood, sections and carried mass
 //!    ([`crate::physics::stem_frequencies`]), so a stem sways at the tapered cantilever's
 //!    frequency and branches at their own, higher ones. `J θ̈ + (c + Γ) θ̇ + k θ = τ` with
