@@ -398,8 +398,7 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
     if let Some(mean) = static_lean(tree, hsm, LEAN_PERIODS / f0, CALM) {
         let lean = mean * (f0 / target).powi(2) / hsm.params.drag_scale.max(f32::MIN_POSITIVE);
         let p = &hsm.params;
-        let shelter = crate::physics::crown_shelter(tree, p.drag, p.leaf_drag);
-        let areas = crate::physics::beam::drag_areas(tree, p.drag, p.leaf_drag, shelter);
+        let areas = crate::physics::beam::drag_areas(tree, p.drag, p.leaf_drag, hsm.layout.shelter);
         let pressure = 0.5 * crate::physics::AIR_DENSITY * CALM * CALM;
         let beam = crate::physics::beam::drag_bend(tree, p.min_radius, &areas).tip[0] * pressure
             / p.stiffness_scale.max(f32::MIN_POSITIVE);

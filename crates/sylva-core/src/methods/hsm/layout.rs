@@ -43,6 +43,9 @@ pub struct HsmLayout {
     pub load_scale: f32,
     /// The trunk's first-mode frequency from the wood, Hz ([`crate::physics::stem_frequencies`]).
     pub sway_hz: f32,
+    /// Factor on the drag of the leaves and side stems, 0–1, so that the crown drags no more
+    /// than as a body ([`crate::physics::crown_shelter`]); the trunk's bark is not sheltered.
+    pub shelter: f32,
 }
 
 struct Builder {
@@ -104,6 +107,7 @@ impl HsmLayout {
                 rate_scale: 1.0,
                 load_scale: 1.0,
                 sway_hz: crate::physics::stem_frequencies(tree, params.min_radius).hz(0),
+                shelter: crate::physics::crown_shelter(tree, params.drag, params.leaf_drag),
             },
             rings: Vec::with_capacity(total_clusters),
             pos: Vec::new(),
@@ -118,7 +122,7 @@ impl HsmLayout {
         let petioles = crate::leaves::LeafFlutter::new(tree, 0);
         // Leaves and side stems drag no more together than the crown as a body, as in the
         // other methods; the trunk's bark is not sheltered.
-        let shelter = crate::physics::crown_shelter(tree, params.drag, params.leaf_drag);
+        let shelter = b.layout.shelter;
         #[allow(clippy::needless_range_loop)] // i indexes every per-segment array of the tree
         'segments: for i in 0..s.len() {
             if b.layout.info.len() >= total_clusters {
