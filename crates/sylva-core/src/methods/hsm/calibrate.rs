@@ -17,7 +17,8 @@
 //!    quarter period ([`side_stem_frequencies`]). Each stem's clusters get their own factor.
 //!    One scale for the whole tree left the aspen's branches and twigs at about half their
 //!    beam frequency: a chain of a few short clusters stands for its beam differently from
-//!    the trunk's long one.
+//!    the trunk's long one. Last, the stems a forked trunk grows on its own level
+//!    (Weber–Penn's clones, the leaders of the black oak's crown), the trunk held.
 //! 3. The trunk again: stiffer side stems hold more of the crown's mass to it (and weigh
 //!    more on the rings they share with it), so its own clusters are scaled back to the
 //!    frequency of step 1, and again while it is more than 2 % off and each pass at least
@@ -29,11 +30,27 @@
 //!    [`crate::physics::beam::drag_bend`]. Rigid clusters ring as their beam does once
 //!    scaled, but a spread load bends them otherwise: by 11× too little on the aspen (a long
 //!    trunk of short, thick segments), by 2× on the palm (its mass in the crown).
+//! 5. A forked trunk's leaders, which those loads bend far more than their beams: on the
+//!    black oak at its mean size (11.7 m) the drag that leans the trunk as its beam leaned
+//!    its eleven other leaders' tops 7 times as far as its own (12.0 against 1.72 % of the
+//!    height in a steady 6 m/s wind), and the crown swung as one at half the trunk's
+//!    frequency. Each leader, the trunk held, is set leaning under those loads as step 4
+//!    sets the trunk, each end read from its own clusters' turns ([`side_stem_leans`]),
+//!    and its rates scaled by its lean over its beam's, so it leans as its beam does; then
+//!    steps 3 and 4 once more. Its own ring, with the trunk held, quickens by the root of
+//!    that factor (at most `STEM_FACTOR`'s 16, which all but two of the oak's leaders
+//!    reach), but held by the trunk it rings with the tree: the oak's leaders' tops lean
+//!    1.69 % against the trunk's 1.67 %, and after the wind stops their mean rings at
+//!    0.85 Hz against the trunk's 0.865 Hz from the wood.
 
 use super::raw::kind;
 use super::{FIXED, Hsm};
 use crate::model::{NONE, Tree};
 use glam::{Quat, Vec3};
+
+/// The trunk's stem: plucked on its own (steps 1 and 3), and held while the stems of its
+/// level that its forks grow (Weber–Penn's clones) are plucked as side stems (step 2).
+const TRUNK: usize = 0;
 
 /// Lateral acceleration of the pluck, m/s² (the dynamics are linear in it but for large
 /// bends; 1 m/s² bends a tree by a small fraction of the wind's).
@@ -137,14 +154,20 @@ enum Top {
     Pose,
 }
 
-/// Each segment from the root to the trunk's end with a cluster, and its vector at rest to
-/// the next joint on the way (the trunk's end for the last): the pose puts the end at
-/// `Σ (R − 1) v` from rest.
-fn trunk_chain(tree: &Tree, hsm: &Hsm) -> Vec<(usize, Vec3)> {
+/// A stem's clusters from its end to its base, each with its vector at rest ([`stem_chain`]).
+type Chain = Vec<(usize, Vec3)>;
+
+/// Each segment of stem `k` with a cluster, from its end to its base, and its vector at rest
+/// to the next joint on the way (the stem's end for the last): with the stem's base held,
+/// the pose puts its end at `Σ (R − 1) v` from rest. The trunk's run to the root.
+fn stem_chain(tree: &Tree, hsm: &Hsm, k: usize) -> Chain {
     let s = &tree.segments;
-    let mut i = (tree.stems.first_segment[0] + tree.stems.segment_count[0] - 1) as usize;
-    let mut next = s.end(i);
     let mut chain = Vec::new();
+    if tree.stems.segment_count[k] == 0 {
+        return chain;
+    }
+    let mut i = (tree.stems.first_segment[k] + tree.stems.segment_count[k] - 1) as usize;
+    let mut next = s.end(i);
     loop {
         let c = hsm.layout.segment_cluster[i];
         if c != NONE {
@@ -152,10 +175,21 @@ fn trunk_chain(tree: &Tree, hsm: &Hsm) -> Vec<(usize, Vec3)> {
         }
         next = s.start[i];
         match s.parent[i] {
-            NONE => return chain,
+            p if p == NONE || s.stem[p as usize] as usize != k => return chain,
             p => i = p as usize,
         }
     }
+}
+
+/// The substep rate the calibration steps `hsm` at, Hz: the one its rates as they stand need
+/// ([`super::HsmParams::substep_rate`], quickened by the root of the rate scale above 1).
+fn substep_rate(hsm: &Hsm) -> f32 {
+    hsm.params.substep_rate * hsm.layout.rate_scale.max(1.0).sqrt()
+}
+
+/// The end of a chain from [`stem_chain`] in the pose, displaced from rest.
+fn chain_end(chain: &[(usize, Vec3)], state: &super::HsmState) -> Vec3 {
+    chain.iter().map(|&(c, v)| Quat::from_array(state.clusters[c].rotation) * v - v).sum()
 }
 
 /// Steps `hsm` from rest under `LOAD` (`speed` `None`) or under the drag of a steady wind of
@@ -171,12 +205,12 @@ fn trunk_run<T>(
     at: Top,
     mut read: impl FnMut(&[f32], f32) -> Option<T>,
 ) -> Option<T> {
-    let rate = hsm.params.substep_rate * hsm.layout.rate_scale.max(1.0).sqrt();
+    let rate = substep_rate(hsm);
     if rate <= 0.0 || tree.stems.is_empty() {
         return None;
     }
     let ring = tip_ring(tree, hsm, 0)?;
-    let chain = trunk_chain(tree, hsm);
+    let chain = stem_chain(tree, hsm, TRUNK);
     let mut state = hsm.state_at_rest();
     if speed.is_none() {
         // No drag (the velocity's w is the particle's drag factor).
@@ -204,10 +238,7 @@ fn trunk_run<T>(
         hsm.substep_with(fields, waves, &mut state, step);
         let xi = match at {
             Top::Ring => ring.iter().map(|&p| state.displacement[p][0]).sum::<f32>() / ring.len() as f32,
-            Top::Pose => {
-                let turn = |&(c, v): &(usize, Vec3)| (Quat::from_array(state.clusters[c].rotation) * v - v).x;
-                chain.iter().map(turn).sum::<f32>()
-            }
+            Top::Pose => chain_end(&chain, &state).x,
         };
         if !xi.is_finite() {
             return None;
@@ -220,33 +251,26 @@ fn trunk_run<T>(
     None
 }
 
-/// The first-mode frequency of every stem of `level` under `hsm`'s dynamics, Hz, with the
-/// levels below held at rest: one entry per stem of the tree, `None` for the other levels
-/// and for stems the layout has no cluster for. Each stem, with all it carries, is set
-/// moving across its axis at rest and its tip ring reaches its first peak after a quarter
-/// period. A stem still rising after `deadline(stem)` seconds reads as that long a quarter
-/// period.
-pub fn side_stem_frequencies(tree: &Tree, hsm: &Hsm, level: u8, deadline: impl Fn(usize) -> f32) -> Vec<Option<f32>> {
+/// The side stems of `level` (the trunk's own level: the stems its forks grow) as the
+/// calibration moves them, with the levels below and the trunk held: the stem of `level`
+/// that carries each stem of the tree (`NONE` for a held one), and the direction each stem
+/// of `level` is moved in, horizontal and square to its axis (along x for an upright stem;
+/// zero for the others and for stems without segments).
+fn carriers(tree: &Tree, level: u8) -> (Vec<u32>, Vec<Vec3>) {
     let st = &tree.stems;
-    let l = &hsm.layout;
-    let mut out = vec![None; st.len()];
-    let rate = hsm.params.substep_rate * l.rate_scale.max(1.0).sqrt();
-    if rate <= 0.0 {
-        return out;
-    }
-    // The stem of `level` that carries each stem, and the direction it is pushed in:
-    // horizontal and square to its axis (or along x for an upright stem).
     let mut carrier = vec![NONE; st.len()];
     let mut push = vec![Vec3::ZERO; st.len()];
     for k in 0..st.len() {
-        carrier[k] = if st.level[k] == level {
+        carrier[k] = if k == TRUNK {
+            NONE
+        } else if st.level[k] == level {
             k as u32
         } else if st.level[k] > level && st.parent[k] != NONE && (st.parent[k] as usize) < k {
             carrier[st.parent[k] as usize]
         } else {
             NONE
         };
-        if st.level[k] == level && st.segment_count[k] > 0 {
+        if carrier[k] == k as u32 && st.segment_count[k] > 0 {
             let first = st.first_segment[k] as usize;
             let last = first + st.segment_count[k] as usize - 1;
             let axis = (tree.segments.end(last) - tree.segments.start[first]).normalize_or_zero();
@@ -254,27 +278,45 @@ pub fn side_stem_frequencies(tree: &Tree, hsm: &Hsm, level: u8, deadline: impl F
             push[k] = if across.length() > 0.1 { across.normalize() } else { Vec3::X };
         }
     }
+    (carrier, push)
+}
+
+/// The stem cluster `c` belongs to (a leaf's: its segment's).
+fn cluster_stem(tree: &Tree, hsm: &Hsm, c: usize) -> usize {
+    let info = hsm.layout.info[c];
+    (match info.kind {
+        kind::SEGMENT => tree.segments.stem[info.source as usize],
+        kind::LEAF => tree.segments.stem[tree.leaves.segment[info.source as usize] as usize],
+        _ => info.source,
+    }) as usize
+}
+
+/// The first-mode frequency of every stem of `level` under `hsm`'s dynamics, Hz, with the
+/// levels below and the trunk held at rest: one entry per stem of the tree, `None` for the
+/// trunk, the other levels and stems the layout has no cluster for. Each stem, with all it
+/// carries, is set moving across its axis at rest ([`carriers`]) and its tip ring reaches
+/// its first peak after a quarter period. A stem still rising after `deadline(stem)` seconds
+/// reads as that long a quarter period.
+pub fn side_stem_frequencies(tree: &Tree, hsm: &Hsm, level: u8, deadline: impl Fn(usize) -> f32) -> Vec<Option<f32>> {
+    let (st, l) = (&tree.stems, &hsm.layout);
+    let (mut out, rate) = (vec![None; st.len()], substep_rate(hsm));
+    if rate <= 0.0 {
+        return out;
+    }
+    let (carrier, push) = carriers(tree, level);
     // Each stem's tip ring.
     let mut probes: Vec<(usize, Vec<usize>, f32)> = Vec::new();
-    for k in (0..st.len()).filter(|&k| st.level[k] == level && st.segment_count[k] > 0) {
+    for k in (0..st.len()).filter(|&k| push[k] != Vec3::ZERO) {
         if let Some(ring) = tip_ring(tree, hsm, k) {
             probes.push((k, ring, deadline(k)));
         }
     }
-    let stem_of = |c: usize| {
-        let info = l.info[c];
-        match info.kind {
-            kind::SEGMENT => tree.segments.stem[info.source as usize],
-            kind::LEAF => tree.segments.stem[tree.leaves.segment[info.source as usize] as usize],
-            _ => info.source,
-        }
-    };
     let mut state = hsm.state_at_rest();
     for (p, v) in state.velocity.iter_mut().enumerate() {
         if v[3] == FIXED {
             continue;
         }
-        let k = carrier[stem_of(l.owner[p] as usize) as usize];
+        let k = carrier[cluster_stem(tree, hsm, l.owner[p] as usize)];
         if k == NONE {
             v[3] = FIXED;
         } else {
@@ -283,20 +325,12 @@ pub fn side_stem_frequencies(tree: &Tree, hsm: &Hsm, level: u8, deadline: impl F
         }
     }
     let h = 1.0 / rate;
-    let mut step = hsm.step_params(0.0, h);
-    step.gravity = [0.0; 4];
-    step.damping = 1.0;
     let longest = probes.iter().map(|p| p.2).fold(0.0f32, f32::max).min(LONGEST);
     let mut x: Vec<Vec<f32>> = vec![Vec::new(); probes.len()];
     let mut best = vec![(0.0f32, 0usize); probes.len()];
     let mut done = vec![false; probes.len()];
     let mut open = probes.len();
-    for i in 0..(longest * rate).ceil() as usize {
-        if open == 0 {
-            break;
-        }
-        step.time = (i + 1) as f32 * h;
-        hsm.substep_with(&[], &[], &mut state, step);
+    held_run(hsm, &mut state, hsm.step_params(0.0, h), (longest * rate).ceil() as usize, |state, i, time| {
         for (q, (k, ring, until)) in probes.iter().enumerate() {
             if done[q] {
                 continue;
@@ -313,14 +347,96 @@ pub fn side_stem_frequencies(tree: &Tree, hsm: &Hsm, level: u8, deadline: impl F
                 (*b, *at) = (xi, i);
             }
             let past = *b > 0.0 && xi < 0.5 * *b;
-            if past || step.time >= *until {
+            if past || time >= *until {
                 let peak = if past { refine(&x[q], *at, h) } else { *until };
                 out[*k] = Some(0.25 / peak);
                 (done[q], open) = (true, open - 1);
             }
         }
-    }
+        open > 0
+    });
     out
+}
+
+/// The static lean of every stem of `level` under the drag of a steady wind of `CALM` m/s
+/// across it (as [`carriers`] moves it), with the levels below and the trunk held, m: the
+/// mean over `window(stem)` seconds from rest of its end's displacement in the pose along
+/// that wind, from its own clusters' turns ([`stem_chain`]). One entry per stem of the tree,
+/// `None` for the other stems. Every cluster a stem carries holds the same wind, as the beam
+/// takes its whole subtree's drag across it ([`crate::physics::beam::drag_bend`]); as
+/// [`static_lean`], without the air's damping or reconfiguration, undamped.
+fn side_stem_leans(tree: &Tree, hsm: &Hsm, level: u8, window: impl Fn(usize) -> f32) -> Vec<Option<f32>> {
+    let (st, l) = (&tree.stems, &hsm.layout);
+    let (mut out, rate) = (vec![None; st.len()], substep_rate(hsm));
+    if rate <= 0.0 {
+        return out;
+    }
+    let (carrier, push) = carriers(tree, level);
+    let probes: Vec<(usize, Chain, f32)> = (0..st.len())
+        .filter(|&k| push[k] != Vec3::ZERO)
+        .map(|k| (k, stem_chain(tree, hsm, k), window(k).min(LONGEST)))
+        .filter(|(_, chain, _)| !chain.is_empty())
+        .collect();
+    let mut state = hsm.state_at_rest();
+    for (p, v) in state.velocity.iter_mut().enumerate() {
+        if v[3] != FIXED && carrier[cluster_stem(tree, hsm, l.owner[p] as usize)] == NONE {
+            v[3] = FIXED;
+        }
+    }
+    // The wind each carried cluster holds (the step does not sample it).
+    for (c, cs) in state.clusters.iter_mut().enumerate() {
+        let k = carrier[cluster_stem(tree, hsm, c)];
+        if k != NONE {
+            let u = push[k as usize] * CALM;
+            cs.wind = [u.x, u.y, u.z, 1.0];
+        }
+    }
+    let h = 1.0 / rate;
+    let mut step = hsm.step_params(0.0, h);
+    (step.air, step.vogel_exponent, step.leaf_turbulence, step.sample_wind) = (0.0, 0.0, 0.0, 0);
+    let longest = probes.iter().map(|p| p.2).fold(0.0f32, f32::max);
+    let mut sum = vec![(0.0f64, 0usize); probes.len()];
+    let mut open = probes.len();
+    held_run(hsm, &mut state, step, (longest * rate).ceil() as usize, |state, _, _| {
+        for (q, (k, chain, until)) in probes.iter().enumerate() {
+            let (total, n) = &mut sum[q];
+            if out[*k].is_some() || *n == usize::MAX {
+                continue;
+            }
+            let xi = chain_end(chain, state).dot(push[*k]);
+            if !xi.is_finite() {
+                (*n, open) = (usize::MAX, open - 1);
+                continue;
+            }
+            (*total, *n) = (*total + xi as f64, *n + 1);
+            if (*n + 1) as f32 * h > *until {
+                out[*k] = Some((*total / *n as f64) as f32);
+                open -= 1;
+            }
+        }
+        open > 0
+    });
+    out
+}
+
+/// Steps `state` from `step` (its `dt` the substep) without gravity or damping for at most
+/// `steps` substeps, handing the state, the substep's index and the time at its end to
+/// `read` after each substep until it answers that nothing is left to read.
+fn held_run(
+    hsm: &Hsm,
+    state: &mut super::HsmState,
+    mut step: super::RawHsmStep,
+    steps: usize,
+    mut read: impl FnMut(&super::HsmState, usize, f32) -> bool,
+) {
+    (step.gravity, step.damping) = ([0.0; 4], 1.0);
+    for i in 0..steps {
+        step.time = (i + 1) as f32 * step.dt;
+        hsm.substep_with(&[], &[], state, step);
+        if !read(state, i, step.time) {
+            return;
+        }
+    }
 }
 
 /// The particles of stem `k`'s tip ring: its last segment cluster's tail ring.
@@ -359,9 +475,14 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
     // Plucked as built, every frequency is `ratio` times what it will be once scaled.
     let ratio = f0 / target;
     let modes = crate::physics::stem_frequencies(tree, hsm.params.min_radius);
-    let want = |k: usize| modes.hz(k) * hsm.params.stiffness_scale.sqrt() * ratio;
+    let pace = hsm.params.stiffness_scale.sqrt() * ratio;
+    let want = |k: usize| modes.hz(k) * pace;
     let deepest = tree.stems.level.iter().copied().max().unwrap_or(0);
-    for level in (1..=deepest).rev() {
+    // The trunk's own level holds the stems its forks grow, if it forks.
+    let st = &tree.stems;
+    let forks = (0..st.len()).any(|k| k != TRUNK && st.level[k] == 0 && st.segment_count[k] > 0);
+    let lowest = if forks { 0 } else { 1 };
+    for level in (lowest..=deepest).rev() {
         let measured = side_stem_frequencies(tree, hsm, level, |k| 1.0 / want(k).max(1e-3));
         let factors: Vec<f32> = measured
             .iter()
@@ -376,7 +497,7 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
     // Stiffer side stems load the trunk more: it is brought back to where it was, and again
     // while it is still off and each pass at least halves what is left (a trunk that the
     // hold keeps from its rates, or that hands its swing to the crown, does not follow them).
-    if deepest > 0 {
+    if deepest > 0 || forks {
         let mut factors = vec![1.0; tree.stems.len()];
         let mut off = f32::INFINITY;
         for pass in 0..TRUNK_PASSES {
@@ -388,23 +509,57 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
                 break;
             }
             off = now;
-            factors[0] = (f0 / f1).powi(2).clamp(STEM_FACTOR.0, STEM_FACTOR.1);
+            factors[TRUNK] = (f0 / f1).powi(2).clamp(STEM_FACTOR.0, STEM_FACTOR.1);
             hsm.layout.scale_stem_rates(tree, &factors);
         }
     }
-    // The drag's scale: the trunk top's static lean in a steady wind, the beam's over the
-    // clusters' (a chain of rigid clusters rings as its beam does but bends under a spread
-    // load otherwise). The final scale of the rates by `s` bends it `1 / s` as far.
+    // Each stem's static bend under its drag and all it carries, the beam's, m.
+    let p = &hsm.params;
+    let areas = crate::physics::beam::drag_areas(tree, p.drag, p.leaf_drag, hsm.layout.shelter);
+    let pressure = 0.5 * crate::physics::AIR_DENSITY * CALM * CALM;
+    let stiffness = p.stiffness_scale.max(f32::MIN_POSITIVE);
+    let bends: Vec<f32> = crate::physics::beam::drag_bend(tree, p.min_radius, &areas)
+        .tip
+        .iter()
+        .map(|tip| tip * pressure / stiffness)
+        .collect();
+    // A lean as built, once the rates are scaled and without the drag's own scale.
+    let calibrated = (f0 / target).powi(2) / hsm.params.drag_scale.max(f32::MIN_POSITIVE);
+    trunk_drag(tree, hsm, f0, calibrated, bends[TRUNK]);
+    // 5. The leaders a forked trunk grows: under the loads that lean the trunk as its beam,
+    // each stiffened until it leans as its own (see the module docs), then the trunk's
+    // frequency and drag once more.
+    if forks {
+        let windows: Vec<f32> = (0..tree.stems.len()).map(|k| LEAN_PERIODS / want(k).max(1e-3)).collect();
+        let leans = side_stem_leans(tree, hsm, 0, |k| windows[k]);
+        let factors: Vec<f32> = leans
+            .iter()
+            .zip(&bends)
+            .map(|(lean, &beam)| match lean.map(|x| x * calibrated) {
+                Some(x) if x > 0.0 && beam > 0.0 && (x * beam).is_finite() => {
+                    (x / beam).clamp(STEM_FACTOR.0, STEM_FACTOR.1)
+                }
+                _ => 1.0,
+            })
+            .collect();
+        hsm.layout.scale_stem_rates(tree, &factors);
+        let mut trunk = vec![1.0; tree.stems.len()];
+        if let Some(f1) = trunk_pluck(tree, hsm, AGAIN / f0) {
+            trunk[TRUNK] = (f0 / f1).powi(2).clamp(STEM_FACTOR.0, STEM_FACTOR.1);
+            hsm.layout.scale_stem_rates(tree, &trunk);
+        }
+        trunk_drag(tree, hsm, f0, calibrated, bends[TRUNK]);
+    }
+    hsm.layout.scale_rates((target / f0).powi(2).clamp(1e-4, 1e4));
+}
+
+/// Scales every particle's drag so the trunk top's static lean in a steady wind, as built
+/// and read as `calibrated` times the run's, is `beam` (m, the beam's under the same drag).
+fn trunk_drag(tree: &Tree, hsm: &mut Hsm, f0: f32, calibrated: f32, beam: f32) {
     if let Some(mean) = static_lean(tree, hsm, LEAN_PERIODS / f0, CALM) {
-        let lean = mean * (f0 / target).powi(2) / hsm.params.drag_scale.max(f32::MIN_POSITIVE);
-        let p = &hsm.params;
-        let areas = crate::physics::beam::drag_areas(tree, p.drag, p.leaf_drag, hsm.layout.shelter);
-        let pressure = 0.5 * crate::physics::AIR_DENSITY * CALM * CALM;
-        let beam = crate::physics::beam::drag_bend(tree, p.min_radius, &areas).tip[0] * pressure
-            / p.stiffness_scale.max(f32::MIN_POSITIVE);
+        let lean = mean * calibrated;
         if lean > 0.0 && beam > 0.0 && (lean * beam).is_finite() {
             hsm.layout.scale_loads((beam / lean).clamp(LOAD_FACTOR.0, LOAD_FACTOR.1));
         }
     }
-    hsm.layout.scale_rates((target / f0).powi(2).clamp(1e-4, 1e4));
 }
