@@ -37,11 +37,11 @@
 //!    frequency. Each leader, the trunk held, is set leaning under those loads as step 4
 //!    sets the trunk, each end read from its own clusters' turns ([`side_stem_leans`]),
 //!    and its rates scaled by its lean over its beam's, so it leans as its beam does; then
-//!    steps 3 and 4 once more. Its own ring, with the trunk held, quickens by the root of
-//!    that factor (at most `STEM_FACTOR`'s 16, which all but two of the oak's leaders
-//!    reach), but held by the trunk it rings with the tree: the oak's leaders' tops lean
-//!    1.69 % against the trunk's 1.67 %, and after the wind stops their mean rings at
-//!    0.85 Hz against the trunk's 0.865 Hz from the wood.
+//!    one pass of step 3 and step 4 again. Its own ring, with the trunk held, quickens by
+//!    the root of that factor (at most `STEM_FACTOR`'s 16, which all but two of the oak's
+//!    leaders reach), but held by the trunk it rings with the tree: the oak's leaders'
+//!    tops lean 1.69 % against the trunk's 1.67 %, and after the wind stops their mean
+//!    rings at 0.85 Hz against the trunk's 0.865 Hz from the wood.
 
 use super::raw::kind;
 use super::{FIXED, Hsm};
