@@ -498,20 +498,7 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
     // while it is still off and each pass at least halves what is left (a trunk that the
     // hold keeps from its rates, or that hands its swing to the crown, does not follow them).
     if deepest > 0 || forks {
-        let mut factors = vec![1.0; tree.stems.len()];
-        let mut off = f32::INFINITY;
-        for pass in 0..TRUNK_PASSES {
-            let Some(f1) = trunk_pluck(tree, hsm, AGAIN / f0) else {
-                break;
-            };
-            let now = (f1 / f0 - 1.0).abs();
-            if pass > 0 && (now <= TRUNK_TOLERANCE || now > 0.5 * off) {
-                break;
-            }
-            off = now;
-            factors[TRUNK] = (f0 / f1).powi(2).clamp(STEM_FACTOR.0, STEM_FACTOR.1);
-            hsm.layout.scale_stem_rates(tree, &factors);
-        }
+        trunk_back(tree, hsm, f0, TRUNK_PASSES);
     }
     // Each stem's static bend under its drag and all it carries, the beam's, m.
     let p = &hsm.params;
@@ -543,14 +530,30 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
             })
             .collect();
         hsm.layout.scale_stem_rates(tree, &factors);
-        let mut trunk = vec![1.0; tree.stems.len()];
-        if let Some(f1) = trunk_pluck(tree, hsm, AGAIN / f0) {
-            trunk[TRUNK] = (f0 / f1).powi(2).clamp(STEM_FACTOR.0, STEM_FACTOR.1);
-            hsm.layout.scale_stem_rates(tree, &trunk);
-        }
+        trunk_back(tree, hsm, f0, 1);
         trunk_drag(tree, hsm, f0, calibrated, bends[TRUNK]);
     }
     hsm.layout.scale_rates((target / f0).powi(2).clamp(1e-4, 1e4));
+}
+
+/// Brings the trunk's pluck back to `f0` by scaling its rates, in at most `passes` passes: a
+/// further pass only while it is off by more than [`TRUNK_TOLERANCE`] and the last pass at
+/// least halved what was left.
+fn trunk_back(tree: &Tree, hsm: &mut Hsm, f0: f32, passes: usize) {
+    let mut factors = vec![1.0; tree.stems.len()];
+    let mut off = f32::INFINITY;
+    for pass in 0..passes {
+        let Some(f1) = trunk_pluck(tree, hsm, AGAIN / f0) else {
+            break;
+        };
+        let now = (f1 / f0 - 1.0).abs();
+        if pass > 0 && (now <= TRUNK_TOLERANCE || now > 0.5 * off) {
+            break;
+        }
+        off = now;
+        factors[TRUNK] = (f0 / f1).powi(2).clamp(STEM_FACTOR.0, STEM_FACTOR.1);
+        hsm.layout.scale_stem_rates(tree, &factors);
+    }
 }
 
 /// Scales every particle's drag so the trunk top's static lean in a steady wind, as built
