@@ -1107,6 +1107,8 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
         assert!(h > 1.0 && r["dbh"].as_f64().unwrap() > 0.0);
         assert_eq!(r["steps"].as_array().unwrap().len(), 4);
         assert!(r["sway_percent"].as_f64().unwrap() > 0.0, "{r}");
+        // The aspen's trunk does not fork: its crown is its trunk top.
+        assert_eq!((r["leaders"].as_u64(), &r["crown_sway_percent"]), (Some(1), &r["sway_percent"]), "{r}");
         if r["method"] == "akagi" {
             // Akagi rings down at its trunk's frequency in still air.
             let f = r["frequency"].as_f64().expect("akagi rings after the pluck");
@@ -1114,7 +1116,19 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
         }
     }
     let md = std::fs::read_to_string(dir.path().join("f/fidelity.md")).unwrap();
-    assert_eq!(md.lines().filter(|l| l.starts_with("| quaking_aspen")).count(), 4 + 8, "{md}");
+    assert_eq!(md.lines().filter(|l| l.starts_with("| quaking_aspen")).count(), 4 + 8 + 2, "{md}");
+    // Side by side, per tree: the methods' spread, most over least of the rows' sway.
+    for size in [0.5, 0.7] {
+        let sway: Vec<f64> = rows
+            .iter()
+            .filter(|r| r["size"].as_f64() == Some(size))
+            .map(|r| r["sway_percent"].as_f64().unwrap())
+            .collect();
+        let spread = sway.iter().cloned().fold(0.0, f64::max) / sway.iter().cloned().fold(f64::MAX, f64::min);
+        let line = md.lines().find(|l| l.starts_with(&format!("| quaking_aspen | ×{size} |")) && l.contains(") – "));
+        assert!(line.is_some_and(|l| l.contains(&format!("| {spread:.2}× |"))), "{spread:.2}: {md}");
+    }
+    assert!(md.contains(" of 2 trees: the methods agree within 2×"), "{md}");
     for png in ["frequency.png", "damping.png", "bend.png", "neighbours.png"] {
         assert_eq!(&std::fs::read(dir.path().join("f").join(png)).unwrap()[..4], b"\x89PNG", "{png}");
     }

@@ -48,6 +48,8 @@ pub struct StepRow {
     pub speed: f32,
     /// Mean downwind displacement of the trunk top over the last fifth, % of height.
     pub lean_percent: f32,
+    /// The same of the mean of the leaders' tops ([`Row::leaders`]), % of height.
+    pub crown_lean_percent: f32,
     /// Damping ratio of the ringing about it (None: it did not ring).
     pub damping: Option<f32>,
 }
@@ -75,6 +77,12 @@ pub struct Row {
     pub steps: Vec<StepRow>,
     /// Standard deviation of the trunk top's horizontal motion in gusty wind, % of height.
     pub sway_percent: f32,
+    /// Stems of level 0 (a trunk that forks grows its leaders on its own level, Weber–Penn's
+    /// clones; 1 where it does not).
+    pub leaders: usize,
+    /// Standard deviation of the horizontal motion of the mean of the leaders' tops in gusty
+    /// wind, % of height: the crown's sway, which a forked trunk's stem 0 alone does not tell.
+    pub crown_sway_percent: f32,
     /// Per stem level 0, 1, 2: share of the variance of the tips' motion relative to their
     /// attachment ([`tip_from_attachment`]) that lies above 1.5 Hz (None: no stems at that
     /// level).
@@ -128,10 +136,19 @@ pub fn measure(
 ) -> Result<Row> {
     let t = &*tree;
     let mut anim = registry.cpu(method, tree.clone(), &MethodOptions::default())?;
-    let top = (t.stems.first_segment[0] + t.stems.segment_count[0] - 1) as usize;
+    let st = &t.stems;
+    let level_of = |k: usize| t.segments.level[st.first_segment[k] as usize] as usize;
+    let end_of = |k: usize| (st.first_segment[k] + st.segment_count[k] - 1) as usize;
+    let top = end_of(0);
     let rest = t.segments.end(top);
     let height = t.height();
     let dx = |pose: &sylva_core::pose::Pose| (pose.end(t, top) - rest).x;
+    // The crown's leaders: the trunk and the stems its forks grow on its own level.
+    let leaders: Vec<usize> =
+        (0..st.len()).filter(|&k| level_of(k) == 0 && st.segment_count[k] > 0).map(end_of).collect();
+    let crown = |pose: &sylva_core::pose::Pose| {
+        leaders.iter().map(|&s| pose.end(t, s) - t.segments.end(s)).sum::<Vec3>() / leaders.len().max(1) as f32
+    };
     // Pluck.
     anim.set_wind(constant(6.0));
     anim.reset(0.0);
@@ -146,37 +163,43 @@ pub fn measure(
     for speed in STEP_SPEEDS {
         anim.set_wind(constant(speed));
         anim.reset(0.0);
-        let x = record(&mut *anim, dt, p.step, dx);
-        let tail = &x[x.len() * 4 / 5..];
-        let lean = tail.iter().sum::<f32>() / tail.len().max(1) as f32;
+        let (x, c): (Vec<f32>, Vec<f32>) =
+            record(&mut *anim, dt, p.step, |pose| (dx(pose), crown(pose).x)).into_iter().unzip();
+        let tail_mean = |v: &[f32]| {
+            let tail = &v[v.len() * 4 / 5..];
+            tail.iter().sum::<f32>() / tail.len().max(1) as f32
+        };
+        let lean = tail_mean(&x);
         let peak = x.iter().fold(0.0f32, |a, v| a.max((v - lean).abs()));
         steps.push(StepRow {
             speed,
             lean_percent: 100.0 * lean / height,
+            crown_lean_percent: 100.0 * tail_mean(&c) / height,
             damping: damping_ratio(&x, lean, 0.05 * peak),
         });
     }
-    // Gusts: the trunk top, and the tips of each level relative to their attachment.
-    let st = &t.stems;
-    let level_of = |k: usize| t.segments.level[st.first_segment[k] as usize] as usize;
+    // Gusts: the trunk top, the crown, and the tips of each level relative to their attachment.
     let tips: Vec<(usize, usize)> =
         (0..st.len()).filter(|&k| level_of(k) <= 2 && st.segment_count[k] > 0).map(|k| (level_of(k), k)).collect();
     anim.set_wind(Arc::new(WindScene::resolve("gusty")?.packed()));
     anim.reset(0.0);
     let samples = record(&mut *anim, dt, p.gusty, |pose| {
-        let mut v = vec![pose.end(t, top)];
+        let mut v = vec![pose.end(t, top) - rest, crown(pose)];
         v.extend(tips.iter().map(|&(_, k)| tip_from_attachment(t, pose, k)));
         v
     });
     let skip = ((10.0 / dt) as usize).min(samples.len() / 2);
     let samples = &samples[skip..];
     let n = samples.len().max(1) as f32;
-    let mean = samples.iter().map(|s| s[0]).sum::<Vec3>() / n;
-    let var = samples.iter().map(|s| ((s[0] - mean) * Vec3::new(1.0, 0.0, 1.0)).length_squared()).sum::<f32>() / n;
+    let sway = |i: usize| {
+        let mean = samples.iter().map(|s| s[i]).sum::<Vec3>() / n;
+        let var = samples.iter().map(|s| ((s[i] - mean) * Vec3::new(1.0, 0.0, 1.0)).length_squared()).sum::<f32>() / n;
+        100.0 * var.sqrt() / height
+    };
     let mut flutter = [(0.0f32, 0.0f32); 3];
     for (j, &(level, _)) in tips.iter().enumerate() {
         for c in 0..3 {
-            let series: Vec<f32> = samples.iter().map(|s| s[j + 1][c]).collect();
+            let series: Vec<f32> = samples.iter().map(|s| s[j + 2][c]).collect();
             let (hi, all) = variance_above(&series, dt, 1.5);
             flutter[level].0 += hi;
             flutter[level].1 += all;
@@ -193,7 +216,9 @@ pub fn measure(
         frequency,
         damping_still,
         steps,
-        sway_percent: 100.0 * var.sqrt() / height,
+        sway_percent: sway(0),
+        leaders: leaders.len(),
+        crown_sway_percent: sway(1),
         flutter: flutter.map(|(hi, all)| (all > 0.0).then(|| hi / all)),
     })
 }
@@ -308,7 +333,49 @@ pub fn neighbours(
 
 #[cfg(test)]
 mod tests {
-    use super::correlation;
+    use super::*;
+
+    /// The black oak's trunk forks into leaders of its own level: the report reads the mean of
+    /// their tops beside stem 0's, and the mean is theirs (each leader's lean at 6 m/s over the
+    /// same tail, taken one at a time). A trunk that does not fork reads its top twice, the
+    /// same to the bit.
+    #[test]
+    fn a_forked_trunks_crown_is_read_beside_its_stem_0() {
+        let p = Protocol { load: 1.0, ring: 2.0, step: 3.0, gusty: 14.0, neighbours: 0.0 };
+        let (dt, registry) = (1.0 / 60.0, sylva_runtime::MethodRegistry::builtin());
+        let oak = grow("ca_black_oak", 1.0).unwrap();
+        let row = measure(&registry, "skjermo", "ca_black_oak", 1.0, oak.clone(), p, dt).unwrap();
+        let st = &oak.stems;
+        let tops: Vec<usize> = (0..st.len())
+            .filter(|&k| st.segment_count[k] > 0 && oak.segments.level[st.first_segment[k] as usize] == 0)
+            .map(|k| (st.first_segment[k] + st.segment_count[k] - 1) as usize)
+            .collect();
+        assert!(tops.len() > 1 && row.leaders == tops.len(), "{} leaders, row {}", tops.len(), row.leaders);
+        let mut anim = registry.cpu("skjermo", oak.clone(), &MethodOptions::default()).unwrap();
+        anim.set_wind(constant(6.0));
+        anim.reset(0.0);
+        let leans = record(&mut *anim, dt, p.step, |pose| {
+            tops.iter().map(|&s| (pose.end(&oak, s) - oak.segments.end(s)).x).collect::<Vec<f32>>()
+        });
+        let tail = &leans[leans.len() * 4 / 5..];
+        let each: Vec<f32> = (0..tops.len())
+            .map(|j| 100.0 * tail.iter().map(|v| v[j]).sum::<f32>() / tail.len() as f32 / oak.height())
+            .collect();
+        let mean = each.iter().sum::<f32>() / each.len() as f32;
+        let at6 = &row.steps[1];
+        assert!(
+            (at6.crown_lean_percent - mean).abs() <= 1e-3 * mean.abs(),
+            "{} against {mean}",
+            at6.crown_lean_percent
+        );
+        assert!((at6.lean_percent - each[0]).abs() <= 1e-3 * each[0].abs(), "{} against {}", at6.lean_percent, each[0]);
+        assert!(at6.crown_lean_percent > 0.0 && at6.crown_lean_percent != at6.lean_percent, "{at6:?}");
+        assert!(row.crown_sway_percent > 0.0 && row.crown_sway_percent != row.sway_percent, "{row:?}");
+        let aspen = grow("quaking_aspen", 0.5).unwrap();
+        let row = measure(&registry, "skjermo", "quaking_aspen", 0.5, aspen, p, dt).unwrap();
+        assert_eq!((row.leaders, row.crown_sway_percent), (1, row.sway_percent));
+        assert!(row.steps.iter().all(|s| s.crown_lean_percent == s.lean_percent), "{:?}", row.steps);
+    }
 
     /// A series correlates fully with itself, not at all with its quadrature, and a delayed
     /// copy is found at its delay.
