@@ -12,8 +12,9 @@
 //!   relative to their attachment, in the frame of the segment they grow from (the parent's
 //!   own sway taken out), that lies above 1.5 Hz (flutter).
 //! - **the crown**: where the trunk forks into leaders of its own level (Weber–Penn's clones),
-//!   the lean and sway of the mean of their tops beside stem 0's, which alone does not tell
-//!   how the drawn crown moves.
+//!   the pluck's frequency and damping, the step responses' lean and damping and the gusty
+//!   sway of the mean of their tops beside stem 0's, which alone does not tell how the drawn
+//!   crown moves.
 //! - **side by side**: per tree, the methods' least and most trunk-top and crown sway, and
 //!   whether they agree within 2× and lie in the field's range.
 //!
@@ -294,14 +295,23 @@ fn report(rows: &[Row], near: &[NeighbourRow], methods: &[String], args: &Fideli
     );
     s += &format!("Field references: {}\n\n", FIELD);
     s += "## Per tree and method\n\n";
-    s += "| species | size | height, m | DBH, m | method | frequency, Hz | ζ still air | ζ at 3/6/10/15 m/s | lean at 3/6/10/15 m/s, % H | gusty sway, % H | crown (leaders' tops): lean at 3/6/10/15 m/s, gusty sway, % H | above 1.5 Hz, levels 0/1/2 |\n";
+    s += "| species | size | height, m | DBH, m | method | frequency, Hz | ζ still air | ζ at 3/6/10/15 m/s | lean at 3/6/10/15 m/s, % H | gusty sway, % H | crown (leaders' tops): frequency; ζ still air, at 3/6/10/15 m/s; lean at 3/6/10/15 m/s, % H; gusty sway, % H | above 1.5 Hz, levels 0/1/2 |\n";
     s += "| --- | ---: | ---: | ---: | --- | ---: | ---: | --- | --- | ---: | --- | --- |\n";
     for r in rows {
         let z: Vec<String> = r.steps.iter().map(|x| opt(x.damping, 3)).collect();
         let lean: Vec<String> = r.steps.iter().map(|x| format!("{:.2}", x.lean_percent)).collect();
         let crown = if r.leaders > 1 {
+            let z: Vec<String> = r.steps.iter().map(|x| opt(x.crown_damping, 3)).collect();
             let lean: Vec<String> = r.steps.iter().map(|x| format!("{:.2}", x.crown_lean_percent)).collect();
-            format!("{} leaders: {}, {:.2}", r.leaders, lean.join(" / "), r.crown_sway_percent)
+            format!(
+                "{} leaders: {} Hz; ζ {}, {}; lean {}; sway {:.2}",
+                r.leaders,
+                opt(r.crown_frequency, 3),
+                opt(r.crown_damping_still, 3),
+                z.join(" / "),
+                lean.join(" / "),
+                r.crown_sway_percent
+            )
         } else {
             "the trunk top".into()
         };

@@ -48,10 +48,12 @@ pub struct StepRow {
     pub speed: f32,
     /// Mean downwind displacement of the trunk top over the last fifth, % of height.
     pub lean_percent: f32,
-    /// The same of the mean of the leaders' tops ([`Row::leaders`]), % of height.
-    pub crown_lean_percent: f32,
-    /// Damping ratio of the ringing about it (None: it did not ring).
+    /// Damping ratio of the trunk top's ringing about that lean (None: it did not ring).
     pub damping: Option<f32>,
+    /// The lean of the mean of the leaders' tops ([`Row::leaders`]), % of height.
+    pub crown_lean_percent: f32,
+    /// The damping ratio of their mean's ringing about it.
+    pub crown_damping: Option<f32>,
 }
 
 /// What one method does with one tree.
@@ -73,6 +75,10 @@ pub struct Row {
     pub frequency: Option<f32>,
     /// Damping ratio of the pluck's ringing in still air.
     pub damping_still: Option<f32>,
+    /// The pluck's frequency read at the mean of the leaders' tops ([`Row::leaders`]), Hz.
+    pub crown_frequency: Option<f32>,
+    /// Its damping ratio in still air.
+    pub crown_damping_still: Option<f32>,
     /// Step responses at [`STEP_SPEEDS`].
     pub steps: Vec<StepRow>,
     /// Standard deviation of the trunk top's horizontal motion in gusty wind, % of height.
@@ -154,10 +160,15 @@ pub fn measure(
     anim.reset(0.0);
     record(&mut *anim, dt, p.load, dx);
     anim.set_wind(Arc::new(WindScene::default().packed()));
-    let ring = record(&mut *anim, dt, p.ring, dx);
-    let peak = ring.iter().fold(0.0f32, |a, v| a.max(v.abs()));
-    let frequency = ringdown_frequency(&ring, dt, 0.0, 0.05 * peak);
-    let damping_still = damping_ratio(&ring, 0.0, 0.05 * peak);
+    let (ring, crown_ring): (Vec<f32>, Vec<f32>) =
+        record(&mut *anim, dt, p.ring, |pose| (dx(pose), crown(pose).x)).into_iter().unzip();
+    // Frequency and damping ratio of a ring-down about rest.
+    let ring_down = |x: &[f32]| {
+        let peak = x.iter().fold(0.0f32, |a, v| a.max(v.abs()));
+        (ringdown_frequency(x, dt, 0.0, 0.05 * peak), damping_ratio(x, 0.0, 0.05 * peak))
+    };
+    let (frequency, damping_still) = ring_down(&ring);
+    let (crown_frequency, crown_damping_still) = ring_down(&crown_ring);
     // Step responses.
     let mut steps = Vec::new();
     for speed in STEP_SPEEDS {
@@ -169,14 +180,14 @@ pub fn measure(
             let tail = &v[v.len() * 4 / 5..];
             tail.iter().sum::<f32>() / tail.len().max(1) as f32
         };
-        let lean = tail_mean(&x);
-        let peak = x.iter().fold(0.0f32, |a, v| a.max((v - lean).abs()));
-        steps.push(StepRow {
-            speed,
-            lean_percent: 100.0 * lean / height,
-            crown_lean_percent: 100.0 * tail_mean(&c) / height,
-            damping: damping_ratio(&x, lean, 0.05 * peak),
-        });
+        // Mean over the last fifth, and the damping ratio of the ringing about it.
+        let settle = |v: &[f32]| {
+            let lean = tail_mean(v);
+            let peak = v.iter().fold(0.0f32, |a, x| a.max((x - lean).abs()));
+            (100.0 * lean / height, damping_ratio(v, lean, 0.05 * peak))
+        };
+        let ((lean_percent, damping), (crown_lean_percent, crown_damping)) = (settle(&x), settle(&c));
+        steps.push(StepRow { speed, lean_percent, crown_lean_percent, damping, crown_damping });
     }
     // Gusts: the trunk top, the crown, and the tips of each level relative to their attachment.
     let tips: Vec<(usize, usize)> =
@@ -215,6 +226,8 @@ pub fn measure(
         dbh_over_h2: dbh / (height * height),
         frequency,
         damping_still,
+        crown_frequency,
+        crown_damping_still,
         steps,
         sway_percent: sway(0),
         leaders: leaders.len(),
@@ -374,7 +387,13 @@ mod tests {
         let aspen = grow("quaking_aspen", 0.5).unwrap();
         let row = measure(&registry, "skjermo", "quaking_aspen", 0.5, aspen, p, dt).unwrap();
         assert_eq!((row.leaders, row.crown_sway_percent), (1, row.sway_percent));
-        assert!(row.steps.iter().all(|s| s.crown_lean_percent == s.lean_percent), "{:?}", row.steps);
+        assert_eq!((row.crown_frequency, row.crown_damping_still), (row.frequency, row.damping_still));
+        assert!(row.frequency.is_some(), "{row:?}");
+        assert!(
+            row.steps.iter().all(|s| (s.crown_lean_percent, s.crown_damping) == (s.lean_percent, s.damping)),
+            "{:?}",
+            row.steps
+        );
     }
 
     /// A series correlates fully with itself, not at all with its quadrature, and a delayed
