@@ -1109,6 +1109,10 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
         assert!(r["sway_percent"].as_f64().unwrap() > 0.0, "{r}");
         // The aspen's trunk does not fork: its crown is its trunk top.
         assert_eq!((r["leaders"].as_u64(), &r["crown_sway_percent"]), (Some(1), &r["sway_percent"]), "{r}");
+        // The beam leans the trunk top further with the aspen's rising side stems' couples.
+        let (at_base, rigid) =
+            (r["beam_lean_percent"].as_f64().unwrap(), r["beam_rigid_lean_percent"].as_f64().unwrap());
+        assert!(at_base > 0.0 && rigid > 1.5 * at_base, "{r}");
         if r["method"] == "akagi" {
             // Akagi rings down at its trunk's frequency in still air.
             let f = r["frequency"].as_f64().expect("akagi rings after the pluck");
@@ -1127,6 +1131,13 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
         let spread = sway.iter().cloned().fold(0.0, f64::max) / sway.iter().cloned().fold(f64::MAX, f64::min);
         let line = md.lines().find(|l| l.starts_with(&format!("| quaking_aspen | ×{size} |")) && l.contains(") – "));
         assert!(line.is_some_and(|l| l.contains(&format!("| {spread:.2}× |"))), "{spread:.2}: {md}");
+        let tree = rows.iter().find(|r| r["size"].as_f64() == Some(size)).unwrap();
+        let beam = format!(
+            "| {:.2} / {:.2} |",
+            tree["beam_lean_percent"].as_f64().unwrap(),
+            tree["beam_rigid_lean_percent"].as_f64().unwrap()
+        );
+        assert!(line.is_some_and(|l| l.contains(&beam)), "{beam}: {md}");
     }
     assert!(md.contains(" of 2 trees: the methods agree within 2×"), "{md}");
     for png in ["frequency.png", "damping.png", "bend.png", "neighbours.png"] {

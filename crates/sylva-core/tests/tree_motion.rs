@@ -707,6 +707,75 @@ fn the_static_bend_of_a_uniform_cantilever_is_the_beam_formula() {
     assert!((bend.pressure_centre[0] / 0.4 - 1.0).abs() < 0.02, "centre {}", bend.pressure_centre[0]);
 }
 
+/// A uniform cantilever as [`cantilever`] (5 m, 2 cm thick) in segments of 6.25 cm, with one
+/// side stem three times as thick rising from 4 m, 2 m long and 10° off the trunk, across
+/// the wind. Akagi turns each segment about its base under the moment there, which bends a
+/// chain of 20 segments 9 % past the beam; of 80, 3 %.
+fn cantilever_with_a_rising_branch() -> Tree {
+    let piece = "F(0.0625)";
+    let trunk = piece.repeat(64) + "[&(10)!(3)" + &piece.repeat(32) + "]" + &piece.repeat(16);
+    let t = Grammar::parse(&format!("width-scale: 0.04\naxiom: !(1){trunk}\n"), "branch.lsys")
+        .unwrap()
+        .generate(&LSystemOptions::default())
+        .unwrap();
+    assert_eq!((t.stems.len(), t.stems.segment_count[0]), (2, 80));
+    t
+}
+
+/// A side stem carried as a rigid body turns the stem it grows from by its load's couple as
+/// well: the tip moves `C a (2L − a) / 2EI` further on a uniform cantilever (a couple `C` at
+/// `a` along it; `C` = each of the side stem's loads times its height above where it starts,
+/// summed here segment by segment), ±1 %.
+#[test]
+fn a_rising_side_stems_couple_bends_a_uniform_cantilever_by_the_beam_formula() {
+    use sylva_core::physics::beam::{SideStems, drag_areas, drag_bend_with};
+    let t = cantilever_with_a_rising_branch();
+    let cd = drag_areas(&t, 0.8, 0.0, 1.0);
+    let at_base = drag_bend_with(&t, 0.0, &cd, SideStems::AtBase).tip[0];
+    let rigid = drag_bend_with(&t, 0.0, &cd, SideStems::Rigid).tip[0];
+    let s = &t.segments;
+    let first = t.stems.first_segment[1] as usize;
+    let base = s.start[first];
+    let couple: f32 = (first..first + t.stems.segment_count[1] as usize)
+        .map(|i| cd[i] * ((s.start[i] + s.end(i)) * 0.5 - base).y)
+        .sum();
+    let (r, l, a) = (s.radius_base[0], t.stems.length[0], base.y);
+    let ei = t.wood.young_modulus * std::f32::consts::FRAC_PI_4 * r.powi(4);
+    let want = couple * a * (2.0 * l - a) / (2.0 * ei);
+    println!(
+        "tip {at_base} m/Pa at base, {rigid} rigid: couple {couple} N·m/Pa adds {} against {want}",
+        rigid - at_base
+    );
+    assert!(((rigid - at_base) / want - 1.0).abs() < 0.01, "{} m/Pa, formula {want}", rigid - at_base);
+}
+
+/// Akagi propagates every load's moment with its whole lever arm, so in a steady wind its
+/// trunk leans as the beam that carries a side stem as a rigid body, not as the beam every
+/// other method takes its bend from, which carries the side stem's load where it starts.
+#[test]
+fn akagi_leans_as_the_beam_that_carries_side_stems_as_rigid_bodies() {
+    use sylva_core::physics::beam::{SideStems, drag_areas, drag_bend_with};
+    use sylva_core::physics::{AIR_DENSITY, DragModel};
+    let t = cantilever_with_a_rising_branch();
+    let p = AkagiParams::default();
+    let cd = drag_areas(&t, p.drag, 0.0, 1.0);
+    let (u, dt) = (5.0, 1.0 / 60.0);
+    let model = DragModel { reconfiguration_speed: p.reconfiguration_speed, vogel_exponent: p.vogel_exponent };
+    let pressure = 0.5 * AIR_DENSITY * u * u * model.reconfiguration(u);
+    let beam = |side| drag_bend_with(&t, p.min_radius, &cd, side).tip[0] * pressure;
+    let (at_base, rigid) = (beam(SideStems::AtBase), beam(SideStems::Rigid));
+    let a = Akagi::new(&t, p);
+    let top = trunk_top(&t);
+    let rest = t.segments.end(top);
+    let mut s = a.rest_state(&t);
+    let x = record(&a, &t, &mut s, &constant(u).packed(), dt, (40.0 / dt) as usize, |q| q.end(&t, top) - rest);
+    let tail = &x[(30.0 / dt) as usize..];
+    let lean = tail.iter().map(|d| d.x).sum::<f32>() / tail.len() as f32;
+    println!("akagi {lean} m; beam {rigid} m rigid, {at_base} m at base");
+    assert!(rigid > 1.15 * at_base, "the couple should show: {rigid} against {at_base}");
+    assert!((lean / rigid - 1.0).abs() < 0.05, "akagi {lean} m, rigid beam {rigid} m (at base {at_base} m)");
+}
+
 /// Frequency of the trunk's first mode against DBH/H² across a size series (×0.8 to ×2,
 /// geometrically similar) of every Weber–Penn preset: linear with R² ≥ 0.9, and 0.2–1 Hz for
 /// trees 10–30 m tall. The black oak's seed 1 draws a 2 m tree (its `scale_v` is its `scale`),

@@ -6,6 +6,8 @@ use glam::Vec3;
 use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::methods::{Animator, MethodOptions};
+use sylva_core::physics;
+use sylva_core::physics::beam::{self, SideStems};
 use sylva_core::physics::measure::{damping_ratio, ringdown_frequency, tip_from_attachment, variance_above};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::{Constant, WindField, WindScene};
@@ -93,6 +95,28 @@ pub struct Row {
     /// attachment ([`tip_from_attachment`]) that lies above 1.5 Hz (None: no stems at that
     /// level).
     pub flutter: [Option<f32>; 3],
+    /// Stem 0's top's static lean in a steady 6 m/s wind (`gusty`'s mean) by the shared beam,
+    /// which carries each side stem's load where it starts ([`beam::drag_bend`], the bend
+    /// Zioma, Skjermo and HSM take), % of height.
+    pub beam_lean_percent: f32,
+    /// The same with each side stem carried as a rigid body, its load's couple about where it
+    /// starts too ([`SideStems::Rigid`]), as Akagi propagates its loads, % of height.
+    pub beam_rigid_lean_percent: f32,
+}
+
+/// Speed of the beam's steady wind ([`Row::beam_lean_percent`]), m/s.
+pub const BEAM_SPEED: f32 = 6.0;
+
+/// Stem 0's top's static lean at [`BEAM_SPEED`] by the shared beam, its side stems carried
+/// where they start and as rigid bodies, % of height: the drag every method applies (bark and
+/// leaves, the crown's shelter, reconfiguration at their defaults, [`physics`]).
+pub fn beam_leans(t: &Tree) -> (f32, f32) {
+    let shelter = physics::crown_shelter(t, physics::BRANCH_DRAG, physics::LEAF_DRAG);
+    let cd = beam::drag_areas(t, physics::BRANCH_DRAG, physics::LEAF_DRAG, shelter);
+    let u = BEAM_SPEED;
+    let pressure = 0.5 * physics::AIR_DENSITY * u * u * physics::DragModel::default().reconfiguration(u);
+    let lean = |side| 100.0 * beam::drag_bend_with(t, physics::MIN_RADIUS, &cd, side).tip[0] * pressure / t.height();
+    (lean(SideStems::AtBase), lean(SideStems::Rigid))
 }
 
 /// A Weber–Penn species grown `factor` times as large, geometrically similar: its size
@@ -217,6 +241,7 @@ pub fn measure(
         }
     }
     let dbh = t.dbh().unwrap_or(0.0);
+    let (beam_lean_percent, beam_rigid_lean_percent) = beam_leans(t);
     Ok(Row {
         species: species.to_string(),
         size,
@@ -233,6 +258,8 @@ pub fn measure(
         leaders: leaders.len(),
         crown_sway_percent: sway(1),
         flutter: flutter.map(|(hi, all)| (all > 0.0).then(|| hi / all)),
+        beam_lean_percent,
+        beam_rigid_lean_percent,
     })
 }
 

@@ -1,7 +1,8 @@
 //! Each stem's first bending mode and static bend, as a continuous tapered cantilever: the
 //! natural frequency from the wood (E, density), its sections and the mass it carries (its
 //! own wood and leaves, and every stem growing from it, lumped where it starts), and the
-//! tip's deflection under the drag on all of that ([`drag_bend`]).
+//! tip's deflection under the drag on all of that ([`drag_bend`]; [`drag_bend_with`] can carry
+//! each side stem as a rigid body instead, its load's couple too, as Akagi does).
 //!
 //! The beam is integrated in [`PIECES`] pieces per segment, each with the section at its
 //! middle (radii tapering from the segment's base to its tip, never under the section that
@@ -14,6 +15,7 @@
 //! to those masses.
 
 use crate::model::Tree;
+use glam::DVec3;
 
 /// Pieces each segment is integrated in.
 pub const PIECES: usize = 8;
@@ -74,23 +76,47 @@ pub struct DragBend {
     pub pressure_centre: Vec<f32>,
 }
 
+/// How a stem's beam carries the stems that grow from it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SideStems {
+    /// Each as its whole load where it starts: the description every method takes its
+    /// frequencies and bends from.
+    AtBase,
+    /// Each as a rigid body on the point it starts from: its whole load there and that load's
+    /// couple about the point, every load beyond times its reach along the stem's axis, as
+    /// Akagi's propagation carries them (children's forces times their whole lever arms). A
+    /// side stem that rises from a thin stem turns it more than its load alone would.
+    Rigid,
+}
+
 /// Each stem's static bend under the drag of the stem and of everything growing from it
 /// (`cd_area`: each segment's `C_d A`, [`drag_areas`]): each segment's own drag spread along
 /// it, every side stem's whole subtree where it starts; sections never thinner than their
 /// [`super::section_floor`] over `min_radius` (m).
 pub fn drag_bend(tree: &Tree, min_radius: f32, cd_area: &[f32]) -> DragBend {
+    drag_bend_with(tree, min_radius, cd_area, SideStems::AtBase)
+}
+
+/// [`drag_bend`] with the side stems carried as `side`. With [`SideStems::Rigid`] the
+/// pressure centre counts each couple's work through the turn where it acts.
+pub fn drag_bend_with(tree: &Tree, min_radius: f32, cd_area: &[f32], side: SideStems) -> DragBend {
     let subtree = subtree_sums(tree, cd_area);
+    let reach = match side {
+        SideStems::AtBase => None,
+        SideStems::Rigid => Some(first_moments(tree, cd_area)),
+    };
     let floor = super::section_floor(tree, min_radius);
     let mut beam = Beam::default();
     let (mut tip, mut pressure_centre) = (Vec::new(), Vec::new());
     for k in 0..tree.stems.len() {
-        beam.bend(tree, k, cd_area, &subtree, &floor);
+        beam.bend(tree, k, cd_area, &subtree, &floor, reach.as_deref());
         let y_tip = beam.tip();
         let (mut force, mut work) = (0.0f64, 0.0f64);
         for &(f, y) in &beam.loads {
             force += f;
             work += f * y;
         }
+        work += beam.couple_work;
         tip.push(y_tip as f32);
         pressure_centre.push(if force > 0.0 && y_tip > 0.0 { (work / (force * y_tip)) as f32 } else { 0.4 });
     }
@@ -108,7 +134,7 @@ pub fn stem_frequencies(tree: &Tree, min_radius: f32) -> StemModes {
     let omega = (0..tree.stems.len())
         .map(|k| {
             // Loads equal to the masses (g = 1); Rayleigh's sums over the deflections.
-            beam.bend(tree, k, &own, &subtree_mass, &floor);
+            beam.bend(tree, k, &own, &subtree_mass, &floor, None);
             let (mut work, mut kinetic) = (0.0f64, 0.0f64);
             for &(m, y) in &beam.loads {
                 work += m * y;
@@ -125,6 +151,21 @@ pub(crate) fn subtree_sums(tree: &Tree, own: &[f32]) -> Vec<f32> {
     let mut sum = own.to_vec();
     for i in (0..sum.len()).rev() {
         let carried: f32 = tree.children.of(i).iter().map(|&c| sum[c as usize]).sum();
+        sum[i] += carried;
+    }
+    sum
+}
+
+/// Each segment's first moment of `own` about the origin with everything beyond it,
+/// `Σ own_j c_j` over its subtree (`c_j` each segment's middle, where its own load acts on
+/// average), m·(unit of `own`).
+fn first_moments(tree: &Tree, own: &[f32]) -> Vec<DVec3> {
+    let s = &tree.segments;
+    let mut sum: Vec<DVec3> = (0..own.len())
+        .map(|i| (s.start[i].as_dvec3() + 0.5 * s.length[i] as f64 * s.axis(i).as_dvec3()) * own[i] as f64)
+        .collect();
+    for i in (0..sum.len()).rev() {
+        let carried: DVec3 = tree.children.of(i).iter().map(|&c| sum[c as usize]).sum();
         sum[i] += carried;
     }
     sum
@@ -147,24 +188,34 @@ impl Piece {
     fn y_at(&self, o: f64) -> f64 {
         self.y + self.slope * o + 0.5 * self.curvature * o * o
     }
+
+    /// Slope `o` along the piece.
+    fn slope_at(&self, o: f64) -> f64 {
+        self.slope + self.curvature * o
+    }
 }
 
 /// A stem bent as a continuous tapered cantilever under lateral point loads.
 #[derive(Debug, Default)]
 struct Beam {
     pieces: Vec<Piece>,
-    /// Each load's piece, offset within it (m) and size.
-    at: Vec<(usize, f64, f64)>,
+    /// Each load's piece, offset within it (m), size and couple (the size times m).
+    at: Vec<(usize, f64, f64, f64)>,
     /// Each load's size and deflection, after [`Beam::bend`].
     loads: Vec<(f64, f64)>,
+    /// The couples' work through the stem's turn where each acts, `Σ C θ`, after
+    /// [`Beam::bend`].
+    couple_work: f64,
     events: Vec<(f64, usize)>,
 }
 
 impl Beam {
     /// Bends stem `k` under `own[i]` spread along each of its segments and `subtree[c]` where
-    /// each side stem starts (unit loads give deflections per load).
-    /// Sections are never thinner than `floor` (per segment, m).
-    fn bend(&mut self, tree: &Tree, k: usize, own: &[f32], subtree: &[f32], floor: &[f32]) {
+    /// each side stem starts (unit loads give deflections per load), and, given each
+    /// segment's subtree first moment `reach` ([`first_moments`]), each side stem's couple
+    /// about where it starts ([`SideStems::Rigid`]). Sections are never thinner than `floor`
+    /// (per segment, m).
+    fn bend(&mut self, tree: &Tree, k: usize, own: &[f32], subtree: &[f32], floor: &[f32], reach: Option<&[DVec3]>) {
         let s = &tree.segments;
         let first = tree.stems.first_segment[k] as usize;
         let count = tree.stems.segment_count[k] as usize;
@@ -180,14 +231,20 @@ impl Beam {
                 let r = (s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * t).max(floor[i]) as f64;
                 let ei = tree.wood.young_modulus as f64 * std::f64::consts::FRAC_PI_4 * r.powi(4);
                 self.pieces.push(Piece { x: x + p as f64 * h, h, ei, ..Default::default() });
-                self.at.push((base + p, 0.5 * h, load as f64 / PIECES as f64));
+                self.at.push((base + p, 0.5 * h, load as f64 / PIECES as f64, 0.0));
             }
             for &c in tree.children.of(i) {
                 let c = c as usize;
                 if s.stem[c] as usize != k {
                     let along = ((s.start[c] - s.start[i]).dot(s.axis(i)) as f64).clamp(0.0, l);
                     let p = ((along / h) as usize).min(PIECES - 1);
-                    self.at.push((base + p, along - p as f64 * h, subtree[c] as f64));
+                    // Σ F (x − x_c)·a over the side stem: its first moment less its load
+                    // times where it starts, along the stem's axis.
+                    let couple = reach.map_or(0.0, |m| {
+                        let a = s.axis(i).as_dvec3();
+                        (m[c] - s.start[c].as_dvec3() * subtree[c] as f64).dot(a)
+                    });
+                    self.at.push((base + p, along - p as f64 * h, subtree[c] as f64, couple));
                 }
             }
             x += l;
@@ -195,7 +252,7 @@ impl Beam {
         // Moments at the pieces' middles: sweep from the tip down over loads and middles,
         // carrying the force beyond and its moment.
         self.events.clear();
-        self.events.extend(self.at.iter().enumerate().map(|(n, &(p, o, _))| (self.pieces[p].x + o, n)));
+        self.events.extend(self.at.iter().enumerate().map(|(n, &(p, o, ..))| (self.pieces[p].x + o, n)));
         self.events.extend(self.pieces.iter().enumerate().map(|(p, q)| (q.x + 0.5 * q.h, usize::MAX - p)));
         self.events.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         let (mut force, mut moment, mut here) = (0.0f64, 0.0f64, x);
@@ -207,6 +264,7 @@ impl Beam {
                 q.curvature = if q.ei > 0.0 { moment / q.ei } else { 0.0 };
             } else {
                 force += self.at[e].2;
+                moment += self.at[e].3;
             }
         }
         // Slopes and deflections from the base.
@@ -218,7 +276,8 @@ impl Beam {
             slope += q.curvature * q.h;
         }
         self.loads.clear();
-        self.loads.extend(self.at.iter().map(|&(p, o, f)| (f, self.pieces[p].y_at(o))));
+        self.loads.extend(self.at.iter().map(|&(p, o, f, _)| (f, self.pieces[p].y_at(o))));
+        self.couple_work = self.at.iter().map(|&(p, o, _, c)| c * self.pieces[p].slope_at(o)).sum();
     }
 
     /// Deflection of the stem's tip.
