@@ -1113,6 +1113,8 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
         let (at_base, rigid) =
             (r["beam_lean_percent"].as_f64().unwrap(), r["beam_rigid_lean_percent"].as_f64().unwrap());
         assert!(at_base > 0.0 && rigid > 1.5 * at_base, "{r}");
+        // Its trunk does not fork: the frame's crown is its trunk top, which leans as the rigid beam.
+        assert!((r["frame_crown_lean_percent"].as_f64().unwrap() / rigid - 1.0).abs() < 0.03, "{r}");
         if r["method"] == "akagi" {
             // Akagi rings down at its trunk's frequency in still air.
             let f = r["frequency"].as_f64().expect("akagi rings after the pluck");
@@ -1133,9 +1135,10 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
         assert!(line.is_some_and(|l| l.contains(&format!("| {spread:.2}× |"))), "{spread:.2}: {md}");
         let tree = rows.iter().find(|r| r["size"].as_f64() == Some(size)).unwrap();
         let beam = format!(
-            "| {:.2} / {:.2} |",
+            "| {:.2} / {:.2}; {:.2} |",
             tree["beam_lean_percent"].as_f64().unwrap(),
-            tree["beam_rigid_lean_percent"].as_f64().unwrap()
+            tree["beam_rigid_lean_percent"].as_f64().unwrap(),
+            tree["frame_crown_lean_percent"].as_f64().unwrap()
         );
         assert!(line.is_some_and(|l| l.contains(&beam)), "{beam}: {md}");
     }

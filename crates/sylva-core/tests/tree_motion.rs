@@ -776,6 +776,72 @@ fn akagi_leans_as_the_beam_that_carries_side_stems_as_rigid_bodies() {
     assert!((lean / rigid - 1.0).abs() < 0.05, "akagi {lean} m, rigid beam {rigid} m (at base {at_base} m)");
 }
 
+/// The whole tree as a frame bends a uniform cantilever under a uniform drag by
+/// `q L⁴ / (8 E I)`, as the beam does (±2 %).
+#[test]
+fn the_whole_tree_frame_bends_a_uniform_cantilever_by_the_beam_formula() {
+    use sylva_core::physics::{beam::drag_areas, frame::static_bend};
+    let t = cantilever();
+    let end = static_bend(&t, 0.0, &drag_areas(&t, 0.8, 0.0, 1.0), Vec3::X);
+    let (r, l) = (t.segments.radius_base[0], t.stems.length[0]);
+    let ei = t.wood.young_modulus * std::f32::consts::FRAC_PI_4 * r.powi(4);
+    let want = 0.8 * 2.0 * r * l.powi(4) / (8.0 * ei);
+    let tip = end[trunk_top(&t)];
+    println!("tip {tip} m/Pa, formula {want}");
+    assert!((tip.x / want - 1.0).abs() < 0.02 && tip.y.abs() < 1e-3 * want, "tip {tip} m/Pa, formula {want}");
+}
+
+/// Every stem flexible, the frame moves a trunk's top as the beam that carries its side stems
+/// as rigid bodies (a side stem's own bend moves only itself): the cantilever with a rising
+/// branch within 0.5 % and the small aspen's trunk, whose stems grow all round it, within 2 %.
+#[test]
+fn the_frame_moves_a_trunk_top_as_the_beam_that_carries_side_stems_as_rigid_bodies() {
+    use sylva_core::physics::beam::{SideStems, drag_areas, drag_bend_with};
+    use sylva_core::physics::{MIN_RADIUS, frame::static_bend};
+    for (name, t, within) in [("branch", cantilever_with_a_rising_branch(), 0.005), ("aspen", small_aspen(), 0.02)] {
+        let cd = drag_areas(&t, 0.8, 0.03, 1.0);
+        let frame = static_bend(&t, MIN_RADIUS, &cd, Vec3::X)[trunk_top(&t)].x;
+        let rigid = drag_bend_with(&t, MIN_RADIUS, &cd, SideStems::Rigid).tip[0];
+        let at_base = drag_bend_with(&t, MIN_RADIUS, &cd, SideStems::AtBase).tip[0];
+        println!("{name}: frame {frame} m/Pa, rigid beam {rigid}, at base {at_base}");
+        assert!((frame / rigid - 1.0).abs() < within, "{name}: frame {frame} m/Pa, rigid beam {rigid}");
+    }
+}
+
+/// Akagi's steady pose is the frame's: in a steady 5 m/s wind the cantilever's top and its
+/// rising branch's tip lean as the frame bends them under Akagi's drag (±5 %; Akagi turns
+/// each 6.25 cm segment about its base, 3 % past the beam on the trunk).
+#[test]
+fn akagi_holds_a_steady_pose_as_the_whole_tree_frame_bends() {
+    use sylva_core::physics::{AIR_DENSITY, DragModel, beam::drag_areas, frame::static_bend};
+    let t = cantilever_with_a_rising_branch();
+    let p = AkagiParams::default();
+    let (u, dt) = (5.0, 1.0 / 60.0);
+    let model = DragModel { reconfiguration_speed: p.reconfiguration_speed, vogel_exponent: p.vogel_exponent };
+    let pressure = 0.5 * AIR_DENSITY * u * u * model.reconfiguration(u);
+    let frame = static_bend(&t, p.min_radius, &drag_areas(&t, p.drag, 0.0, 1.0), Vec3::X);
+    let tips = [trunk_top(&t), (t.stems.first_segment[1] + t.stems.segment_count[1] - 1) as usize];
+    let a = Akagi::new(&t, p);
+    let mut s = a.rest_state(&t);
+    let steps = (40.0 / dt) as usize;
+    let mut sum = [Vec3::ZERO; 2];
+    for k in 0..steps {
+        a.step(&t, &constant(u).packed(), &mut s, dt);
+        if k >= (30.0 / dt) as usize {
+            let pose = a.pose(&t, &constant(u).packed(), &s);
+            for (acc, &i) in sum.iter_mut().zip(&tips) {
+                *acc += pose.end(&t, i) - t.segments.end(i);
+            }
+        }
+    }
+    let n = (steps - (30.0 / dt) as usize) as f32;
+    for (acc, &i) in sum.iter().zip(&tips) {
+        let (akagi, want) = (*acc / n, frame[i] * pressure);
+        println!("segment {i}: akagi {akagi} m, frame {want} m");
+        assert!((akagi - want).length() < 0.05 * want.length(), "segment {i}: akagi {akagi} m, frame {want} m");
+    }
+}
+
 /// Frequency of the trunk's first mode against DBH/H² across a size series (×0.8 to ×2,
 /// geometrically similar) of every Weber–Penn preset: linear with R² ≥ 0.9, and 0.2–1 Hz for
 /// trees 10–30 m tall. The black oak's seed 1 draws a 2 m tree (its `scale_v` is its `scale`),

@@ -19,7 +19,8 @@
 //!   whether they agree within 2× and lie in the field's range; beside them the shared beam's
 //!   static lean of stem 0's top at 6 m/s, its side stems carried where they start (the bend
 //!   Zioma, Skjermo and HSM take) and as rigid bodies with their couples (as Akagi carries
-//!   them, [`sylva_core::physics::beam::SideStems`]).
+//!   them, [`sylva_core::physics::beam::SideStems`]), and the crown's by the whole tree as a
+//!   frame ([`sylva_core::physics::frame`]).
 //!
 //! References ([`runs::FIELD`]): 0.2–1 Hz for 10–30 m trees and frequency linear in DBH/H²
 //! (Moore & Maguire 2004, 602 trees); damping ratios 0.02–0.2 rising with wind; trunk-top
@@ -256,11 +257,11 @@ fn side_by_side(rows: &[Row]) -> String {
     }
     let mut s = String::from("\n## Per tree: the methods side by side\n\n");
     s += "Gusty sway (% H), the least and the most over the methods, and most ÷ least. The crown is the mean of \
-          the leaders' tops where the trunk forks into leaders of its own level. The beam: stem 0's top's static \
-          lean at 6 m/s by the shared description, which carries each side stem's load where it starts (the bend \
-          Zioma, Skjermo and HSM take), and with each side stem a rigid body, its load's couple about where it \
-          starts too, as Akagi's propagation carries them.\n\n";
-    s += "| species | size | height, m | beam: lean at 6 m/s, side stems at base / rigid, % H | trunk top: least – most | spread | crown: least – most | spread | within 2× | all in 0.5–3 % |\n";
+          the leaders' tops where the trunk forks into leaders of its own level. Static leans at 6 m/s: stem 0's \
+          top by the shared beam, which carries each side stem's load where it starts (the bend Zioma, Skjermo \
+          and HSM take), and with each side stem a rigid body, its load's couple about where it starts too, as \
+          Akagi's propagation carries them; and the crown by the whole tree as a frame, every stem flexible.\n\n";
+    s += "| species | size | height, m | static lean at 6 m/s, % H: beam, side stems at base / rigid; frame, crown | trunk top: least – most | spread | crown: least – most | spread | within 2× | all in 0.5–3 % |\n";
     s += "| --- | ---: | ---: | --- | --- | ---: | --- | ---: | ---: | ---: |\n";
     let (mut agree, mut inside) = (0, 0);
     for &(species, size) in &trees {
@@ -276,10 +277,11 @@ fn side_by_side(rows: &[Row]) -> String {
         agree += within as usize;
         inside += field as usize;
         s += &format!(
-            "| {species} | ×{size} | {:.1} | {:.2} / {:.2} | {top} | {top_spread:.2}× | {crown} | {} | {} | {} |\n",
+            "| {species} | ×{size} | {:.1} | {:.2} / {:.2}; {:.2} | {top} | {top_spread:.2}× | {crown} | {} | {} | {} |\n",
             mine[0].height,
             mine[0].beam_lean_percent,
             mine[0].beam_rigid_lean_percent,
+            mine[0].frame_crown_lean_percent,
             if forked { format!("{crown_spread:.2}×") } else { "–".into() },
             if within { "yes" } else { "no" },
             if field { "yes" } else { "no" },

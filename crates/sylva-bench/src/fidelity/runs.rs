@@ -6,9 +6,9 @@ use glam::Vec3;
 use std::sync::Arc;
 use sylva_core::Tree;
 use sylva_core::methods::{Animator, MethodOptions};
-use sylva_core::physics;
 use sylva_core::physics::beam::{self, SideStems};
 use sylva_core::physics::measure::{damping_ratio, ringdown_frequency, tip_from_attachment, variance_above};
+use sylva_core::physics::{self, frame};
 use sylva_core::species::SpeciesSource;
 use sylva_core::wind::{Constant, WindField, WindScene};
 
@@ -102,21 +102,34 @@ pub struct Row {
     /// The same with each side stem carried as a rigid body, its load's couple about where it
     /// starts too ([`SideStems::Rigid`]), as Akagi propagates its loads, % of height.
     pub beam_rigid_lean_percent: f32,
+    /// The mean static lean of the leaders' tops ([`Row::leaders`]; the trunk top where the
+    /// trunk does not fork) by the whole tree as a frame, every stem flexible
+    /// ([`frame::static_bend`]), % of height.
+    pub frame_crown_lean_percent: f32,
 }
 
 /// Speed of the beam's steady wind ([`Row::beam_lean_percent`]), m/s.
 pub const BEAM_SPEED: f32 = 6.0;
 
-/// Stem 0's top's static lean at [`BEAM_SPEED`] by the shared beam, its side stems carried
-/// where they start and as rigid bodies, % of height: the drag every method applies (bark and
-/// leaves, the crown's shelter, reconfiguration at their defaults, [`physics`]).
-pub fn beam_leans(t: &Tree) -> (f32, f32) {
+/// Static leans at [`BEAM_SPEED`], % of height, under the drag every method applies (bark and
+/// leaves, the crown's shelter, reconfiguration at their defaults, [`physics`]): stem 0's top
+/// by the shared beam, its side stems carried where they start and as rigid bodies, and the
+/// mean of the leaders' tops by the whole tree as a frame.
+pub fn beam_leans(t: &Tree) -> [f32; 3] {
     let shelter = physics::crown_shelter(t, physics::BRANCH_DRAG, physics::LEAF_DRAG);
     let cd = beam::drag_areas(t, physics::BRANCH_DRAG, physics::LEAF_DRAG, shelter);
     let u = BEAM_SPEED;
     let pressure = 0.5 * physics::AIR_DENSITY * u * u * physics::DragModel::default().reconfiguration(u);
-    let lean = |side| 100.0 * beam::drag_bend_with(t, physics::MIN_RADIUS, &cd, side).tip[0] * pressure / t.height();
-    (lean(SideStems::AtBase), lean(SideStems::Rigid))
+    let percent = 100.0 * pressure / t.height();
+    let lean = |side| beam::drag_bend_with(t, physics::MIN_RADIUS, &cd, side).tip[0] * percent;
+    let st = &t.stems;
+    let tops: Vec<usize> = (0..st.len())
+        .filter(|&k| st.level[k] == 0 && st.segment_count[k] > 0)
+        .map(|k| (st.first_segment[k] + st.segment_count[k] - 1) as usize)
+        .collect();
+    let bend = frame::static_bend(t, physics::MIN_RADIUS, &cd, Vec3::X);
+    let crown = tops.iter().map(|&i| bend[i].x).sum::<f32>() / tops.len().max(1) as f32 * percent;
+    [lean(SideStems::AtBase), lean(SideStems::Rigid), crown]
 }
 
 /// A Weber–Penn species grown `factor` times as large, geometrically similar: its size
@@ -241,7 +254,7 @@ pub fn measure(
         }
     }
     let dbh = t.dbh().unwrap_or(0.0);
-    let (beam_lean_percent, beam_rigid_lean_percent) = beam_leans(t);
+    let [beam_lean_percent, beam_rigid_lean_percent, frame_crown_lean_percent] = beam_leans(t);
     Ok(Row {
         species: species.to_string(),
         size,
@@ -260,6 +273,7 @@ pub fn measure(
         flutter: flutter.map(|(hi, all)| (all > 0.0).then(|| hi / all)),
         beam_lean_percent,
         beam_rigid_lean_percent,
+        frame_crown_lean_percent,
     })
 }
 

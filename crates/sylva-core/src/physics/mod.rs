@@ -1,10 +1,12 @@
 //! The tree as a mechanical body, shared by every method: air, drag coefficients, the
 //! mechanical radius of a joint, the loads a stem carries, each stem's natural frequency
-//! ([`beam`]) and drag with reconfiguration and damping ([`drag`]). Methods keep their
-//! papers' mechanisms and take their constants from here.
+//! ([`beam`]), the whole tree's static bend ([`frame`]) and drag with reconfiguration and
+//! damping ([`drag`]). Methods keep their papers' mechanisms and take their constants from
+//! here.
 
 pub mod beam;
 pub mod drag;
+pub mod frame;
 pub mod measure;
 pub mod oscillator;
 
