@@ -159,7 +159,7 @@ pub(crate) fn subtree_sums(tree: &Tree, own: &[f32]) -> Vec<f32> {
 /// Each segment's first moment of `own` about the origin with everything beyond it,
 /// `Σ own_j c_j` over its subtree (`c_j` each segment's middle, where its own load acts on
 /// average), m·(unit of `own`).
-fn first_moments(tree: &Tree, own: &[f32]) -> Vec<DVec3> {
+pub(super) fn first_moments(tree: &Tree, own: &[f32]) -> Vec<DVec3> {
     let s = &tree.segments;
     let mut sum: Vec<DVec3> = (0..own.len())
         .map(|i| (s.start[i].as_dvec3() + 0.5 * s.length[i] as f64 * s.axis(i).as_dvec3()) * own[i] as f64)
@@ -169,6 +169,15 @@ fn first_moments(tree: &Tree, own: &[f32]) -> Vec<DVec3> {
         sum[i] += carried;
     }
     sum
+}
+
+/// Flexural rigidity `E I` of piece `p` of segment `i`, N·m²: the section at the piece's
+/// middle, tapering from the segment's base to its tip, never under `floor[i]` (m).
+pub(super) fn piece_rigidity(tree: &Tree, i: usize, p: usize, floor: &[f32]) -> f64 {
+    let s = &tree.segments;
+    let t = (p as f32 + 0.5) / PIECES as f32;
+    let r = (s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * t).max(floor[i]) as f64;
+    tree.wood.young_modulus as f64 * std::f64::consts::FRAC_PI_4 * r.powi(4)
 }
 
 /// One piece of a stem: where it starts along the stem, its length and flexural rigidity,
@@ -227,9 +236,7 @@ impl Beam {
             let h = l / PIECES as f64;
             let base = self.pieces.len();
             for p in 0..PIECES {
-                let t = (p as f32 + 0.5) / PIECES as f32;
-                let r = (s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * t).max(floor[i]) as f64;
-                let ei = tree.wood.young_modulus as f64 * std::f64::consts::FRAC_PI_4 * r.powi(4);
+                let ei = piece_rigidity(tree, i, p, floor);
                 self.pieces.push(Piece { x: x + p as f64 * h, h, ei, ..Default::default() });
                 self.at.push((base + p, 0.5 * h, load as f64 / PIECES as f64, 0.0));
             }

@@ -22,22 +22,13 @@ use glam::{DVec3, Vec3};
 pub fn static_bend(tree: &Tree, min_radius: f32, load: &[f32], direction: Vec3) -> Vec<Vec3> {
     let s = &tree.segments;
     let n = s.len();
-    let e = tree.wood.young_modulus as f64;
     let dir = direction.as_dvec3();
     let floor = super::section_floor(tree, min_radius);
     let axis: Vec<DVec3> = (0..n).map(|i| s.axis(i).as_dvec3()).collect();
     let start: Vec<DVec3> = (0..n).map(|i| s.start[i].as_dvec3()).collect();
     // Each segment's load with everything beyond it, and its first moment Σ F p.
-    let mut force: Vec<f64> = load.iter().map(|&f| f as f64).collect();
-    let mut moment: Vec<DVec3> =
-        (0..n).map(|i| (start[i] + axis[i] * (0.5 * s.length[i] as f64)) * load[i] as f64).collect();
-    for i in (0..n).rev() {
-        for &c in tree.children.of(i) {
-            let (f, m) = (force[c as usize], moment[c as usize]);
-            force[i] += f;
-            moment[i] += m;
-        }
-    }
+    let force = super::beam::subtree_sums(tree, load);
+    let moment = super::beam::first_moments(tree, load);
     // Per piece: the turn and displacement at its start and its curvature vector.
     let mut theta = vec![DVec3::ZERO; n * PIECES];
     let mut shift = vec![DVec3::ZERO; n * PIECES];
@@ -63,15 +54,13 @@ pub fn static_bend(tree: &Tree, min_radius: f32, load: &[f32], direction: Vec3) 
             }
             for &(o, c) in &kids {
                 if o > along {
-                    f += force[c];
+                    f += force[c] as f64;
                     m += moment[c];
                 }
             }
             let bending = (m - x * f).cross(dir);
             let bending = bending - a * bending.dot(a);
-            let t = (p as f32 + 0.5) / PIECES as f32;
-            let r = (s.radius_base[i] + (s.radius_tip[i] - s.radius_base[i]) * t).max(floor[i]) as f64;
-            let ei = e * std::f64::consts::FRAC_PI_4 * r.powi(4);
+            let ei = super::beam::piece_rigidity(tree, i, p, &floor);
             kappa[i * PIECES + p] = if ei > 0.0 { bending / ei } else { DVec3::ZERO };
         }
         // Where the parent has moved and turned to at this segment's start.
