@@ -1116,9 +1116,12 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
         // Its trunk does not fork: the frame's crown is its trunk top, which leans as the rigid beam.
         assert!((r["frame_crown_lean_percent"].as_f64().unwrap() / rigid - 1.0).abs() < 0.03, "{r}");
         if r["method"] == "akagi" {
-            // Akagi rings down at its trunk's frequency in still air.
+            // Akagi rings down at its trunk's frequency in still air, the shared beam's, which
+            // the whole tree's sway mode as a frame meets within 10 % on the aspen.
             let f = r["frequency"].as_f64().expect("akagi rings after the pluck");
             assert!(f > 0.05 && f < 5.0, "{f}");
+            let sway = r["frame_sway_hz"].as_f64().expect("the frame finds a sway mode");
+            assert!((sway / f - 1.0).abs() < 0.1 && r["frame_sway_share"].as_f64().unwrap() >= 0.05, "{r}");
         }
     }
     let md = std::fs::read_to_string(dir.path().join("f/fidelity.md")).unwrap();
@@ -1141,6 +1144,12 @@ fn fidelity_quick_measures_each_method_beside_the_field_references() {
             tree["frame_crown_lean_percent"].as_f64().unwrap()
         );
         assert!(line.is_some_and(|l| l.contains(&beam)), "{beam}: {md}");
+        let sway = format!(
+            "| {:.3} ({:.0} %) |",
+            tree["frame_sway_hz"].as_f64().unwrap(),
+            100.0 * tree["frame_sway_share"].as_f64().unwrap()
+        );
+        assert!(line.is_some_and(|l| l.contains(&sway)), "{sway}: {md}");
     }
     assert!(md.contains(" of 2 trees: the methods agree within 2×"), "{md}");
     for png in ["frequency.png", "damping.png", "bend.png", "neighbours.png"] {

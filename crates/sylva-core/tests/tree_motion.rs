@@ -1212,3 +1212,59 @@ fn every_method_streamlines_in_strong_wind() {
         assert!((r - want).abs() <= 0.4, "{name}: bend ratio {r}, drag ratio {want}");
     }
 }
+
+/// The whole tree as a frame rings a uniform cantilever at the beam's first two modes,
+/// `(1.875² / 2π) √(E I / ρ A) / L²` and `(4.694² / 2π) …`, each as a pair (along x and z),
+/// within 1 %, and its first mode swings 61.3 % of the mass (the uniform cantilever's effective
+/// mass, ±2 %).
+#[test]
+fn the_whole_tree_frame_rings_a_uniform_cantilever_at_its_first_two_beam_modes() {
+    use sylva_core::physics::frame::{modes, sway_mode};
+    let t = cantilever();
+    let m = modes(&t, 0.0, 4);
+    let f1 = beam_frequency(&t);
+    let f2 = f1 * (4.694f32 / 1.875).powi(2);
+    let found: Vec<(f32, f32)> = m.iter().map(|x| (x.hz, x.horizontal_share())).collect();
+    println!("frame modes (Hz, horizontal mass share) {found:?}; beam {f1} and {f2} Hz");
+    assert_eq!(m.len(), 4);
+    for (k, want) in [(0, f1), (1, f1), (2, f2), (3, f2)] {
+        assert!((m[k].hz / want - 1.0).abs() < 0.01, "mode {k}: {} Hz, beam {want} Hz", m[k].hz);
+    }
+    let share = sway_mode(&m).unwrap().horizontal_share();
+    assert!((share / 0.613 - 1.0).abs() < 0.02, "first mode's share {share}");
+    assert!(m.iter().all(|x| x.mass_share.y < 1e-4), "{found:?}");
+}
+
+/// The frame's modes are the same bits whatever the thread count (its trial shapes are bent
+/// in parallel), lowest first.
+#[test]
+fn the_frames_modes_do_not_depend_on_the_thread_count() {
+    use sylva_core::physics::{MIN_RADIUS, frame::modes};
+    let t = small_aspen();
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(|| modes(&t, MIN_RADIUS, 6));
+    let many = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap().install(|| modes(&t, MIN_RADIUS, 6));
+    assert_eq!(one, many);
+    let hz: Vec<f32> = one.iter().map(|m| m.hz).collect();
+    println!("small aspen's lowest frame modes {hz:?} Hz");
+    assert!(hz.windows(2).all(|w| w[0] <= w[1]) && hz[0] > 0.0, "{hz:?}");
+}
+
+/// The shared beam lumps each side stem's mass where it starts; the whole tree as a frame
+/// swings them on their stems. On the small aspen its sway mode (the one that swings the most
+/// of the tree's mass horizontally) rings within 10 % of the beam's trunk frequency, which
+/// every method sways at.
+#[test]
+fn the_frames_sway_mode_rings_at_the_shared_beams_trunk_frequency() {
+    use sylva_core::physics::{
+        MIN_RADIUS,
+        frame::{modes, sway_mode},
+    };
+    let t = small_aspen();
+    let m = modes(&t, MIN_RADIUS, 12);
+    let sway = sway_mode(&m).unwrap();
+    let beam = stem_frequencies(&t, MIN_RADIUS).hz(0);
+    let found: Vec<(f32, f32)> = m.iter().map(|x| (x.hz, x.horizontal_share())).collect();
+    println!("frame modes (Hz, horizontal mass share) {found:?}; beam {beam} Hz");
+    assert!((sway.hz / beam - 1.0).abs() < 0.1, "sway mode {} Hz, beam {beam} Hz", sway.hz);
+    assert!(sway.horizontal_share() > 0.1, "{found:?}");
+}

@@ -20,7 +20,10 @@
 //!   static lean of stem 0's top at 6 m/s, its side stems carried where they start (the bend
 //!   Zioma, Skjermo and HSM take) and as rigid bodies with their couples (as Akagi carries
 //!   them, [`sylva_core::physics::beam::SideStems`]), and the crown's by the whole tree as a
-//!   frame ([`sylva_core::physics::frame`]).
+//!   frame ([`sylva_core::physics::frame`]); and the frame's sway mode (of its lowest modes,
+//!   the one that swings the most of the tree's mass horizontally, every side stem swinging
+//!   on its stem) beside the methods' plucks, which ring at the shared beam's trunk frequency
+//!   (each side stem's mass where it starts).
 //!
 //! References ([`runs::FIELD`]): 0.2–1 Hz for 10–30 m trees and frequency linear in DBH/H²
 //! (Moore & Maguire 2004, 602 trees); damping ratios 0.02–0.2 rising with wind; trunk-top
@@ -94,8 +97,9 @@ pub fn run(args: &FidelityArgs) -> Result<Vec<PathBuf>> {
     for species in list(&args.species) {
         for &size in &sizes {
             let tree = runs::grow(&species, size)?;
+            let figures = runs::tree_figures(&tree);
             for m in &methods {
-                jobs.push((species.clone(), size, m.clone(), tree.clone()));
+                jobs.push((species.clone(), size, m.clone(), tree.clone(), figures));
             }
         }
     }
@@ -109,8 +113,8 @@ pub fn run(args: &FidelityArgs) -> Result<Vec<PathBuf>> {
     let bar = indicatif::ProgressBar::new(jobs.len() as u64);
     let rows: Vec<Row> = jobs
         .into_par_iter()
-        .map(|(species, size, method, tree)| {
-            let r = measure(&registry, &method, &species, size, tree, protocol, 1.0 / args.rate);
+        .map(|(species, size, method, tree, figures)| {
+            let r = measure(&registry, &method, &species, size, tree, &figures, protocol, 1.0 / args.rate);
             bar.inc(1);
             r
         })
@@ -260,9 +264,11 @@ fn side_by_side(rows: &[Row]) -> String {
           the leaders' tops where the trunk forks into leaders of its own level. Static leans at 6 m/s: stem 0's \
           top by the shared beam, which carries each side stem's load where it starts (the bend Zioma, Skjermo \
           and HSM take), and with each side stem a rigid body, its load's couple about where it starts too, as \
-          Akagi's propagation carries them; and the crown by the whole tree as a frame, every stem flexible.\n\n";
-    s += "| species | size | height, m | static lean at 6 m/s, % H: beam, side stems at base / rigid; frame, crown | trunk top: least – most | spread | crown: least – most | spread | within 2× | all in 0.5–3 % |\n";
-    s += "| --- | ---: | ---: | --- | --- | ---: | --- | ---: | ---: | ---: |\n";
+          Akagi's propagation carries them; and the crown by the whole tree as a frame, every stem flexible. \
+          The frame's sway mode: of its lowest modes, the one that swings the most of the tree's mass \
+          horizontally (its share in brackets), beside the methods' pluck frequencies, least – most.\n\n";
+    s += "| species | size | height, m | static lean at 6 m/s, % H: beam, side stems at base / rigid; frame, crown | frame's sway mode, Hz (share of mass) | pluck, Hz | trunk top: least – most | spread | crown: least – most | spread | within 2× | all in 0.5–3 % |\n";
+    s += "| --- | ---: | ---: | --- | --- | --- | --- | ---: | --- | ---: | ---: | ---: |\n";
     let (mut agree, mut inside) = (0, 0);
     for &(species, size) in &trees {
         let mine: Vec<&Row> = rows.iter().filter(|r| r.species == species && r.size == size).collect();
@@ -276,12 +282,19 @@ fn side_by_side(rows: &[Row]) -> String {
             .all(|r| (0.5..=3.0).contains(&r.sway_percent) && (!forked || (0.5..=3.0).contains(&r.crown_sway_percent)));
         agree += within as usize;
         inside += field as usize;
+        let plucks: Vec<f32> = mine.iter().filter_map(|r| r.frequency).collect();
+        let pluck = match (plucks.iter().copied().reduce(f32::min), plucks.iter().copied().reduce(f32::max)) {
+            (Some(lo), Some(hi)) => format!("{lo:.3} – {hi:.3}"),
+            _ => "–".into(),
+        };
         s += &format!(
-            "| {species} | ×{size} | {:.1} | {:.2} / {:.2}; {:.2} | {top} | {top_spread:.2}× | {crown} | {} | {} | {} |\n",
+            "| {species} | ×{size} | {:.1} | {:.2} / {:.2}; {:.2} | {} ({:.0} %) | {pluck} | {top} | {top_spread:.2}× | {crown} | {} | {} | {} |\n",
             mine[0].height,
             mine[0].beam_lean_percent,
             mine[0].beam_rigid_lean_percent,
             mine[0].frame_crown_lean_percent,
+            opt(mine[0].frame_sway_hz, 3),
+            100.0 * mine[0].frame_sway_share,
             if forked { format!("{crown_spread:.2}×") } else { "–".into() },
             if within { "yes" } else { "no" },
             if field { "yes" } else { "no" },

@@ -106,6 +106,38 @@ pub struct Row {
     /// trunk does not fork) by the whole tree as a frame, every stem flexible
     /// ([`frame::static_bend`]), % of height.
     pub frame_crown_lean_percent: f32,
+    /// The whole tree's sway mode as a frame, every side stem swinging on its stem
+    /// ([`frame::sway_mode`] of its [`FRAME_MODES`] lowest modes), Hz; None where none of them
+    /// swings [`SWAY_SHARE`] of the tree's mass horizontally.
+    pub frame_sway_hz: Option<f32>,
+    /// The share of the tree's mass that mode swings horizontally.
+    pub frame_sway_share: f32,
+}
+
+/// Modes of the whole tree as a frame that [`tree_figures`] finds.
+pub const FRAME_MODES: usize = 12;
+
+/// Least horizontal share of the tree's mass a frame mode swings to be read as its sway mode.
+pub const SWAY_SHARE: f32 = 0.05;
+
+/// What the tree itself gives, the same under every method: the static leans
+/// ([`beam_leans`]) and its sway mode as a frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TreeFigures {
+    /// [`beam_leans`].
+    pub leans: [f32; 3],
+    /// [`Row::frame_sway_hz`].
+    pub sway_hz: Option<f32>,
+    /// [`Row::frame_sway_share`].
+    pub sway_share: f32,
+}
+
+/// The figures of `t` that do not depend on the method.
+pub fn tree_figures(t: &Tree) -> TreeFigures {
+    let modes = frame::modes(t, physics::MIN_RADIUS, FRAME_MODES);
+    let sway = frame::sway_mode(&modes);
+    let sway_share = sway.map_or(0.0, |m| m.horizontal_share());
+    TreeFigures { leans: beam_leans(t), sway_hz: sway.filter(|_| sway_share >= SWAY_SHARE).map(|m| m.hz), sway_share }
 }
 
 /// Speed of the beam's steady wind ([`Row::beam_lean_percent`]), m/s.
@@ -167,13 +199,16 @@ fn record<T>(
         .collect()
 }
 
-/// Runs the pluck, the step responses and the gusts of `method` on `tree`.
+/// Runs the pluck, the step responses and the gusts of `method` on `tree` (whose own
+/// figures, [`tree_figures`], the row carries).
+#[allow(clippy::too_many_arguments)]
 pub fn measure(
     registry: &sylva_runtime::MethodRegistry,
     method: &str,
     species: &str,
     size: f64,
     tree: Arc<Tree>,
+    figures: &TreeFigures,
     p: Protocol,
     dt: f32,
 ) -> Result<Row> {
@@ -254,7 +289,7 @@ pub fn measure(
         }
     }
     let dbh = t.dbh().unwrap_or(0.0);
-    let [beam_lean_percent, beam_rigid_lean_percent, frame_crown_lean_percent] = beam_leans(t);
+    let [beam_lean_percent, beam_rigid_lean_percent, frame_crown_lean_percent] = figures.leans;
     Ok(Row {
         species: species.to_string(),
         size,
@@ -274,6 +309,8 @@ pub fn measure(
         beam_lean_percent,
         beam_rigid_lean_percent,
         frame_crown_lean_percent,
+        frame_sway_hz: figures.sway_hz,
+        frame_sway_share: figures.sway_share,
     })
 }
 
@@ -398,7 +435,9 @@ mod tests {
         let p = Protocol { load: 1.0, ring: 2.0, step: 3.0, gusty: 14.0, neighbours: 0.0 };
         let (dt, registry) = (1.0 / 60.0, sylva_runtime::MethodRegistry::builtin());
         let oak = grow("ca_black_oak", 1.0).unwrap();
-        let row = measure(&registry, "skjermo", "ca_black_oak", 1.0, oak.clone(), p, dt).unwrap();
+        // The tree's own figures are not read here.
+        let none = TreeFigures { leans: [0.0; 3], sway_hz: None, sway_share: 0.0 };
+        let row = measure(&registry, "skjermo", "ca_black_oak", 1.0, oak.clone(), &none, p, dt).unwrap();
         let st = &oak.stems;
         let tops: Vec<usize> = (0..st.len())
             .filter(|&k| st.segment_count[k] > 0 && oak.segments.level[st.first_segment[k] as usize] == 0)
@@ -426,7 +465,7 @@ mod tests {
         assert!(at6.crown_lean_percent > 0.0 && at6.crown_lean_percent != at6.lean_percent, "{at6:?}");
         assert!(row.crown_sway_percent > 0.0 && row.crown_sway_percent != row.sway_percent, "{row:?}");
         let aspen = grow("quaking_aspen", 0.5).unwrap();
-        let row = measure(&registry, "skjermo", "quaking_aspen", 0.5, aspen, p, dt).unwrap();
+        let row = measure(&registry, "skjermo", "quaking_aspen", 0.5, aspen, &none, p, dt).unwrap();
         assert_eq!((row.leaders, row.crown_sway_percent), (1, row.sway_percent));
         assert_eq!((row.crown_frequency, row.crown_damping_still), (row.frequency, row.damping_still));
         assert!(row.frequency.is_some(), "{row:?}");
