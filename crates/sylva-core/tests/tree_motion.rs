@@ -1268,3 +1268,21 @@ fn the_frames_sway_mode_rings_at_the_shared_beams_trunk_frequency() {
     assert!((sway.hz / beam - 1.0).abs() < 0.1, "sway mode {} Hz, beam {beam} Hz", sway.hz);
     assert!(sway.horizontal_share() > 0.1, "{found:?}");
 }
+
+/// Regression: the frame's modes moved each segment's mass as one, at the segment's mean
+/// displacement, and the Lombardy poplar, whose trunk is one 25 m segment, rang at 0.349 Hz
+/// where its beam rings at 0.240. A uniform cantilever drawn as a single 5 m segment rings at
+/// the beam formula within 2 %.
+#[test]
+fn a_cantilever_drawn_as_one_segment_rings_in_the_frame_at_the_beam_formula() {
+    use sylva_core::physics::frame::modes;
+    let t = Grammar::parse("width-scale: 0.04\naxiom: !(1)F(5)\n", "rod.lsys")
+        .unwrap()
+        .generate(&LSystemOptions::default())
+        .unwrap();
+    assert_eq!(t.segments.len(), 1);
+    let f = modes(&t, 0.0, 2)[0].hz;
+    let beam = beam_frequency(&t);
+    println!("one 5 m segment: frame {f} Hz, beam formula {beam} Hz");
+    assert!((f / beam - 1.0).abs() < 0.02, "frame {f} Hz, beam formula {beam} Hz");
+}
