@@ -110,7 +110,8 @@ pub fn modes(tree: &Tree, min_radius: f32, count: usize) -> Vec<FrameMode> {
     while x.len() < q {
         x.push(random());
     }
-    let mut found: Vec<(f64, Vec<DVec3>)> = Vec::new();
+    // The block's Ritz values, ω², lowest first (its shapes are `x`).
+    let mut lambda: Vec<f64> = Vec::new();
     for _ in 0..MAX_ITERATIONS {
         let bent: Vec<Vec<DVec3>> = x.par_iter().map(|shape| bend(shape)).collect();
         let norm: Vec<f64> = bent.iter().map(|b| dot(b, b).sqrt().max(f64::MIN_POSITIVE)).collect();
@@ -137,7 +138,8 @@ pub fn modes(tree: &Tree, min_radius: f32, count: usize) -> Vec<FrameMode> {
         let mut order: Vec<usize> = (0..keep.len()).collect();
         order.sort_by(|&a, &b| ke.eigenvalues[a].total_cmp(&ke.eigenvalues[b]));
         let qm = &w * &ke.eigenvectors;
-        let next: Vec<(f64, Vec<DVec3>)> = order
+        let next: Vec<f64> = order.iter().map(|&j| ke.eigenvalues[j]).collect();
+        x = order
             .iter()
             .map(|&j| {
                 let mut shape = vec![DVec3::ZERO; dofs];
@@ -147,32 +149,31 @@ pub fn modes(tree: &Tree, min_radius: f32, count: usize) -> Vec<FrameMode> {
                         *s += *u * c;
                     }
                 }
-                (ke.eigenvalues[j], shape)
+                shape
             })
             .collect();
-        let settled = found.len() >= count
+        let settled = lambda.len() >= count
             && next.len() >= count
-            && (0..count).all(|j| (next[j].0 - found[j].0).abs() <= TOLERANCE * next[j].0.abs());
-        x = next.iter().map(|(_, shape)| shape.clone()).collect();
-        while x.len() < q {
-            x.push(random());
-        }
-        found = next;
+            && (0..count).all(|j| (next[j] - lambda[j]).abs() <= TOLERANCE * next[j].abs());
+        lambda = next;
         if settled {
             break;
         }
+        while x.len() < q {
+            x.push(random());
+        }
     }
-    found
-        .into_iter()
+    x.iter()
+        .zip(&lambda)
         .take(count)
-        .map(|(l, shape)| {
+        .map(|(shape, &l)| {
             let share = |e: DVec3| {
                 let g: f64 = shape.iter().zip(&mass).map(|(u, m)| m * u.dot(e)).sum();
                 (g * g / total) as f32
             };
             // Each segment's mean over its parts.
             let mut mean = vec![DVec3::ZERO; n];
-            for (&(i, _, w), u) in parts.iter().zip(&shape) {
+            for (&(i, _, w), u) in parts.iter().zip(shape) {
                 mean[i] += *u * (w as f64 / PIECES as f64);
             }
             FrameMode {
