@@ -244,7 +244,11 @@ fn zioma_trunk_frequency_does_not_depend_on_the_time_step() {
 
 #[test]
 fn zioma_damping_is_in_the_field_range_and_rises_with_wind() {
-    damping_is_in_the_field_range_and_rises_with_wind("zioma", 0.25, |t| Zioma::new(t, ZiomaParams::default()));
+    // Zioma's small-branch chaos rides on its trunk at about a tenth of the lean, and its ring,
+    // damped by the air as its mode moves (ζ 0.062–0.095 in its model here), sinks into it
+    // within a few peaks: read above 0.3 of the first peak (above 0.25 the readings at 6 and
+    // 10 m/s were 0.0687 and 0.0681; above 0.3 they are 0.76–0.89 of the model's).
+    damping_is_in_the_field_range_and_rises_with_wind("zioma", 0.3, |t| Zioma::new(t, ZiomaParams::default()));
 }
 
 fn hsm(t: &Tree) -> Hsm {
@@ -269,9 +273,9 @@ fn hsm_damping_is_in_the_field_range_and_rises_with_wind() {
 /// HSM's `drag_scale` (3) also tripled the air's damping, and its ζ passed 0.2 at 15 m/s on
 /// the 16 and 21 m aspens. The drag's scales (the calibration's and `drag_scale`) carry the
 /// load only: the lean in a steady wind is the same with the air's damping at its default
-/// or at the scales (±1 %), and the ring is damped less. At its default (`air_damping` 2)
+/// or at the scales (±1 %), and the ring is damped less. At its default (`air_damping` 3)
 /// the trunk rings down at 15 m/s as the continuous beam's does (Skjermo's ζ, ±20 %;
-/// measured 0.066 against 0.069).
+/// measured 0.080 against 0.095; at 2, 0.067).
 #[test]
 fn hsm_drag_scale_scales_the_load_not_the_air_damping() {
     let t = small_aspen();
@@ -693,7 +697,8 @@ fn the_stem_frequency_of_a_uniform_cantilever_is_the_beam_formula() {
 }
 
 /// The static bend under a uniform drag: tip deflection `q L⁴ / (8 E I)` with
-/// `q = C_d · 2r` per pascal, and the centre of pressure at 0.4 of the tip's motion (±2 %).
+/// `q = C_d · 2r` per pascal, and the air's damping weighed at `∫φ² / ∫φ` = 52/81 of the
+/// tip's speed, `φ` the deflection shape under a uniform load (±2 %).
 #[test]
 fn the_static_bend_of_a_uniform_cantilever_is_the_beam_formula() {
     use sylva_core::physics::beam::{drag_areas, drag_bend};
@@ -702,9 +707,9 @@ fn the_static_bend_of_a_uniform_cantilever_is_the_beam_formula() {
     let (r, l) = (t.segments.radius_base[0], t.stems.length[0]);
     let ei = t.wood.young_modulus * std::f32::consts::FRAC_PI_4 * r.powi(4);
     let want = 0.8 * 2.0 * r * l.powi(4) / (8.0 * ei);
-    println!("tip {} m/Pa, formula {want}; centre {}", bend.tip[0], bend.pressure_centre[0]);
+    println!("tip {} m/Pa, formula {want}; damping centre {}", bend.tip[0], bend.damping_centre[0]);
     assert!((bend.tip[0] / want - 1.0).abs() < 0.02, "tip {} m/Pa, formula {want}", bend.tip[0]);
-    assert!((bend.pressure_centre[0] / 0.4 - 1.0).abs() < 0.02, "centre {}", bend.pressure_centre[0]);
+    assert!((bend.damping_centre[0] / (52.0 / 81.0) - 1.0).abs() < 0.02, "centre {}", bend.damping_centre[0]);
 }
 
 /// A uniform cantilever as [`cantilever`] (5 m, 2 cm thick) in segments of 6.25 cm, with one
@@ -1285,4 +1290,64 @@ fn a_cantilever_drawn_as_one_segment_rings_in_the_frame_at_the_beam_formula() {
     let beam = beam_frequency(&t);
     println!("one 5 m segment: frame {f} Hz, beam formula {beam} Hz");
     assert!((f / beam - 1.0).abs() < 0.02, "frame {f} Hz, beam formula {beam} Hz");
+}
+
+/// The air's damping of a stem's mode weighs each part's drag by how far it moves with the
+/// mode, squared (`DragBend::damping_centre`). Along a uniform cantilever the drag's damping
+/// per metre, `c = ρ C_d 2r u g(u)`, and the mass per metre, `m = ρ_w π r²`, are the same
+/// everywhere, so any mode's air damping ratio is `c / (2 m ω)` whatever its shape. Skjermo's
+/// ring in a steady wind is damped by the wood's ratio plus that (±10 %), and Zioma's trunk
+/// model says the same (±3 %). Weighed by the mean of the shape, as they were, the air's part
+/// was 0.62 of it.
+#[test]
+fn the_air_damps_a_uniform_cantilevers_mode_as_the_continuous_beam() {
+    use sylva_core::methods::zioma::trunk::TrunkModel;
+    use sylva_core::physics::{AIR_DENSITY, BRANCH_DRAG, DragModel, LEAF_DRAG, STRUCTURAL_DAMPING};
+    let t = cantilever();
+    let r = t.segments.radius_base[0];
+    let w = std::f32::consts::TAU * beam_frequency(&t);
+    let mass = t.wood.density * std::f32::consts::PI * r * r;
+    let skjermo = Skjermo::new(&t, SkjermoParams::default());
+    let zioma = TrunkModel::for_tree(&t, BRANCH_DRAG, LEAF_DRAG);
+    for u in [6.0f32, 10.0, 15.0, 20.0] {
+        let c = AIR_DENSITY * BRANCH_DRAG * 2.0 * r * u * DragModel::default().reconfiguration(u);
+        let want = c / (2.0 * mass * w);
+        let (_, z) = step_response(&skjermo, &t, u, 0.05);
+        let model = zioma.damping(u) - STRUCTURAL_DAMPING;
+        println!(
+            "{u} m/s: the air's ζ {want:.4}; Skjermo rings at {:.4}, Zioma's model {model:.4}",
+            z - STRUCTURAL_DAMPING
+        );
+        assert!(((z - STRUCTURAL_DAMPING) / want - 1.0).abs() < 0.1, "{u} m/s: Skjermo {z}, the air's {want}");
+        assert!((model / want - 1.0).abs() < 0.03, "{u} m/s: Zioma's model {model}, the air's {want}");
+    }
+}
+
+/// A stem forked from the trunk's base carries its drag where the trunk's mode barely moves:
+/// it neither pushes that mode nor damps it. Weighed by the mean of the shape over all the
+/// drag the trunk carries, the fork's drag diluted the trunk's air damping: the black oak's
+/// stem 0, one of twelve leaders from low forks, was weighed at 0.016 of its tip's speed
+/// (0.36 now), so Zioma and Skjermo rang it at ζ 0.043 in 6 m/s where Akagi's propagation
+/// rings it at 0.14 (0.11–0.14 now).
+/// With the fork the uniform cantilever's damping weight and Zioma's ζ at 10 m/s stay within
+/// 2 % of the lone cantilever's.
+#[test]
+fn a_stem_forked_from_the_base_does_not_dilute_the_air_damping_of_the_trunks_mode() {
+    use sylva_core::methods::zioma::trunk::TrunkModel;
+    use sylva_core::physics::beam::{drag_areas, drag_bend};
+    use sylva_core::physics::{BRANCH_DRAG, LEAF_DRAG};
+    let lone = cantilever();
+    let axiom = "!(1)F(0.25)[&(30)!(3)F(1)F(1)]".to_string() + &"F(0.25)".repeat(19);
+    let forked = Grammar::parse(&format!("width-scale: 0.04\naxiom: {axiom}\n"), "forked.lsys")
+        .unwrap()
+        .generate(&LSystemOptions::default())
+        .unwrap();
+    assert_eq!((forked.stems.len(), forked.stems.segment_count[0]), (2, 20));
+    let centre = |t: &Tree| drag_bend(t, 0.0, &drag_areas(t, BRANCH_DRAG, 0.0, 1.0)).damping_centre[0];
+    let zeta = |t: &Tree| TrunkModel::for_tree(t, BRANCH_DRAG, LEAF_DRAG).damping(10.0);
+    let (a, b) = (centre(&lone), centre(&forked));
+    let (za, zb) = (zeta(&lone), zeta(&forked));
+    println!("damping centre {a:.4} alone, {b:.4} forked; ζ at 10 m/s {za:.4} alone, {zb:.4} forked");
+    assert!((b / a - 1.0).abs() < 0.02, "centre {b} forked against {a} alone");
+    assert!((zb / za - 1.0).abs() < 0.02, "ζ {zb} forked against {za} alone");
 }

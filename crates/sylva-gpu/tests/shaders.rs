@@ -264,7 +264,7 @@ fn animation_structs_match_their_wgsl_twins() {
             ("crown_centre", offset_of!(RawZiomaTrunk, crown_centre)),
             ("natural_frequency", offset_of!(RawZiomaTrunk, natural_frequency)),
             ("tip_per_pascal", offset_of!(RawZiomaTrunk, tip_per_pascal)),
-            ("pressure_centre", offset_of!(RawZiomaTrunk, pressure_centre)),
+            ("damping_centre", offset_of!(RawZiomaTrunk, damping_centre)),
             ("lever", offset_of!(RawZiomaTrunk, lever)),
             ("damping_ratio", offset_of!(RawZiomaTrunk, damping_ratio)),
             ("reconfiguration_speed", offset_of!(RawZiomaTrunk, reconfiguration_speed)),

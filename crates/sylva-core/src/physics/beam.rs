@@ -70,11 +70,21 @@ pub fn drag_areas(tree: &Tree, bark_drag: f32, leaf_drag: f32, shelter: f32) -> 
 pub struct DragBend {
     /// Static tip deflection per pascal of dynamic pressure `½ ρ u²`, m/Pa (tree order).
     pub tip: Vec<f32>,
-    /// Where the drag acts, as a fraction of the tip's motion: the drag-weighted mean of
-    /// the deflection shape, `Σ F y / (Σ F · y_tip)` (0.4 for a uniform load on a uniform
-    /// cantilever; more where the load sits near the tip, as a crown does).
-    pub pressure_centre: Vec<f32>,
+    /// How fast the drag's point of work moves, as a share of the tip's speed: with the bend
+    /// as the stem's mode shape `φ = y / y_tip`, a part moving at `φ` times the tip's speed
+    /// loses `ρ C_d A u g φ` of its drag, which the mode feels times `φ` again, so the mode's
+    /// aerodynamic damping is the tip's `ρ u g Σ a φ²` against the stiffness that gives the
+    /// tip `Σ a φ` per pascal: the weight `Σ F y² / (y_tip Σ F y)` (52/81 ≈ 0.642 for a
+    /// uniform load on a uniform cantilever; more where the load sits near the tip, as a crown
+    /// does). Loads where a stem barely moves (its side stems lumped near its base, a forked
+    /// trunk's other leaders) neither push its mode nor damp it. Side stems count where they
+    /// start (their couples' own motion is left out).
+    pub damping_centre: Vec<f32>,
 }
+
+/// [`DragBend::damping_centre`] of a uniform load on a uniform cantilever, `∫φ² / ∫φ` with
+/// `φ(ξ) = (ξ⁴ − 4ξ³ + 6ξ²) / 3`: the weight of a stem that does not bend.
+pub const UNIFORM_CENTRE: f32 = 52.0 / 81.0;
 
 /// How a stem's beam carries the stems that grow from it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -97,8 +107,7 @@ pub fn drag_bend(tree: &Tree, min_radius: f32, cd_area: &[f32]) -> DragBend {
     drag_bend_with(tree, min_radius, cd_area, SideStems::AtBase)
 }
 
-/// [`drag_bend`] with the side stems carried as `side`. With [`SideStems::Rigid`] the
-/// pressure centre counts each couple's work through the turn where it acts.
+/// [`drag_bend`] with the side stems carried as `side`.
 pub fn drag_bend_with(tree: &Tree, min_radius: f32, cd_area: &[f32], side: SideStems) -> DragBend {
     let subtree = subtree_sums(tree, cd_area);
     let reach = match side {
@@ -107,20 +116,19 @@ pub fn drag_bend_with(tree: &Tree, min_radius: f32, cd_area: &[f32], side: SideS
     };
     let floor = super::section_floor(tree, min_radius);
     let mut beam = Beam::default();
-    let (mut tip, mut pressure_centre) = (Vec::new(), Vec::new());
+    let (mut tip, mut damping_centre) = (Vec::new(), Vec::new());
     for k in 0..tree.stems.len() {
         beam.bend(tree, k, cd_area, &subtree, &floor, reach.as_deref());
         let y_tip = beam.tip();
-        let (mut force, mut work) = (0.0f64, 0.0f64);
+        let (mut work, mut squares) = (0.0f64, 0.0f64);
         for &(f, y) in &beam.loads {
-            force += f;
             work += f * y;
+            squares += f * y * y;
         }
-        work += beam.couple_work;
         tip.push(y_tip as f32);
-        pressure_centre.push(if force > 0.0 && y_tip > 0.0 { (work / (force * y_tip)) as f32 } else { 0.4 });
+        damping_centre.push(if work > 0.0 && y_tip > 0.0 { (squares / (work * y_tip)) as f32 } else { UNIFORM_CENTRE });
     }
-    DragBend { tip, pressure_centre }
+    DragBend { tip, damping_centre }
 }
 
 /// The first bending mode of every stem of `tree`, with sections never thinner than their
@@ -197,11 +205,6 @@ impl Piece {
     fn y_at(&self, o: f64) -> f64 {
         self.y + self.slope * o + 0.5 * self.curvature * o * o
     }
-
-    /// Slope `o` along the piece.
-    fn slope_at(&self, o: f64) -> f64 {
-        self.slope + self.curvature * o
-    }
 }
 
 /// A stem bent as a continuous tapered cantilever under lateral point loads.
@@ -212,9 +215,6 @@ struct Beam {
     at: Vec<(usize, f64, f64, f64)>,
     /// Each load's size and deflection, after [`Beam::bend`].
     loads: Vec<(f64, f64)>,
-    /// The couples' work through the stem's turn where each acts, `Σ C θ`, after
-    /// [`Beam::bend`].
-    couple_work: f64,
     events: Vec<(f64, usize)>,
 }
 
@@ -284,7 +284,6 @@ impl Beam {
         }
         self.loads.clear();
         self.loads.extend(self.at.iter().map(|&(p, o, f, _)| (f, self.pieces[p].y_at(o))));
-        self.couple_work = self.at.iter().map(|&(p, o, _, c)| c * self.pieces[p].slope_at(o)).sum();
     }
 
     /// Deflection of the stem's tip.

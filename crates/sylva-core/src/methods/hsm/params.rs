@@ -84,11 +84,11 @@ pub struct HsmParams {
     /// calibration's scale: a particle's drag is `kd |r| r` on the relative velocity
     /// `r = wind − (air_damping / scales) v`, so the load in still parts is the scaled drag's
     /// and the drag's change with the particle's own velocity (`∂F/∂v`, the aerodynamic
-    /// damping) is `air_damping` times the sheltered drag's. Default 2: the trunk rings down
-    /// in wind as the continuous beam's (Skjermo's) does: on the aspen's size series ζ at
-    /// 15 m/s is 0.073–0.079 (Skjermo's 0.063–0.073), rising with the wind at every size, and
-    /// second-level tips keep 16–51 % of their motion above 1.5 Hz (same command). With 5 ζ
-    /// was 0.13–0.14 and the twigs of the 21 m tree kept only 9.9 % of theirs above 1.5 Hz.
+    /// damping) is `air_damping` times the sheltered drag's. Default 3: the trunk rings down
+    /// in wind near the continuous beam's (Skjermo's, whose air damping weighs each part by
+    /// how far it moves with the mode): on the small aspen (12.3 m) ζ at 15 m/s is 0.080
+    /// against the beam's 0.095 (0.067 with 2). With 5 the aspen's size series rang at ζ
+    /// 0.13–0.14 and the twigs of its 21 m tree kept only 9.9 % of their motion above 1.5 Hz.
     pub air_damping: f32,
     /// Speed around which bark and leaves streamline, m/s (see
     /// [`crate::physics::DragModel`]; default 5, as the other methods).
@@ -162,7 +162,7 @@ impl Default for HsmParams {
             drag: 0.8,
             leaf_drag: 0.05,
             drag_scale: 0.85,
-            air_damping: 2.0,
+            air_damping: 3.0,
             reconfiguration_speed: crate::physics::DragModel::default().reconfiguration_speed,
             vogel_exponent: crate::physics::DragModel::default().vogel_exponent,
             gravity: 9.81,

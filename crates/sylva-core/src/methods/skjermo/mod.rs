@@ -31,8 +31,9 @@
 //!   (`physics::beam::drag_bend`), `½ ρ u²` on each segment's `C_d A` of bark and
 //!   leaves.
 //! * Aerodynamic damping from drag on a moving stem, `F(w − v)`: linearised about the wind,
-//!   the push drops by `2 c/u` per m/s the stem's centre of pressure moves downwind, which
-//!   moves at `DragBend::pressure_centre` of the tip's speed; applied implicitly.
+//!   the push drops by `2 c/u` per m/s the drag's point of work moves downwind, which moves
+//!   at `DragBend::damping_centre` of the tip's speed (each part weighed by how far it moves
+//!   with the stem's mode); applied implicitly.
 //!
 //! Because a stem reads its parent's previous curve, motion reaches level d one step after
 //! level d − 1: **level d lags d steps** behind the trunk (§5); at 60 steps/s a four-level
@@ -267,7 +268,7 @@ impl Skjermo {
             .collect();
         let modes = stems
             .iter()
-            .zip(beam.omega.iter().zip(&bend.pressure_centre))
+            .zip(beam.omega.iter().zip(&bend.damping_centre))
             .map(|(stem, (&w, &centre))| RawSkjermoMode {
                 w2: w * w,
                 damping: params.damping_ratio * w,

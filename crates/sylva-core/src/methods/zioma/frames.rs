@@ -23,7 +23,7 @@ impl RawZiomaTrunk {
         TrunkModel {
             natural_frequency: self.natural_frequency,
             tip_per_pascal: self.tip_per_pascal,
-            pressure_centre: self.pressure_centre,
+            damping_centre: self.damping_centre,
             lever: self.lever,
             damping_ratio: self.damping_ratio,
             drag: DragModel { reconfiguration_speed: self.reconfiguration_speed, vogel_exponent: self.vogel_exponent },

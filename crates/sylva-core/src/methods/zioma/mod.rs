@@ -257,7 +257,7 @@ impl Zioma {
             crown_centre: self.crown_centre.to_array(),
             natural_frequency: m.natural_frequency,
             tip_per_pascal: m.tip_per_pascal,
-            pressure_centre: m.pressure_centre,
+            damping_centre: m.damping_centre,
             lever: m.lever,
             damping_ratio: m.damping_ratio,
             reconfiguration_speed: m.drag.reconfiguration_speed,

@@ -73,8 +73,8 @@ pub struct RawZiomaTrunk {
     pub natural_frequency: f32,
     /// Trunk-top deflection per pascal on the crown, m/Pa.
     pub tip_per_pascal: f32,
-    /// Centre of pressure, share of the tip's motion.
-    pub pressure_centre: f32,
+    /// Share of the tip's speed at which the drag's point of work moves (the air's damping).
+    pub damping_centre: f32,
     /// Trunk-top motion per radian of arc, m.
     pub lever: f32,
     /// Structural damping ratio.

@@ -16,7 +16,8 @@
 //!   reconfiguration, [`DragModel`]), spread over the trunk as an arc whose top moves by
 //!   that deflection δ ([`TrunkModel::lever`]);
 //! * the **damping ratio**: the wood's ([`STRUCTURAL_DAMPING`]) plus the air's, from the
-//!   drag on the moving crown at its centre of pressure, so it rises with the wind.
+//!   drag on the moving crown, each part weighed by how far it moves with the trunk's mode
+//!   ([`crate::physics::beam::DragBend::damping_centre`]), so it rises with the wind.
 //!
 //! Fields without waves (constant, gust front, vortex, blast) pass through unfiltered
 //! (quasi-statically). When the wind itself changes (it starts, stops, is swapped or
@@ -64,8 +65,9 @@ pub struct TrunkModel {
     pub natural_frequency: f32,
     /// Trunk-top deflection per pascal of dynamic pressure on the crown, m/Pa.
     pub tip_per_pascal: f32,
-    /// Centre of pressure: the share of the tip's motion where the drag acts.
-    pub pressure_centre: f32,
+    /// Share of the tip's speed at which the drag's point of work moves, which weighs the
+    /// air's damping ([`crate::physics::beam::DragBend::damping_centre`]).
+    pub damping_centre: f32,
     /// How far the trunk top moves per radian of arc, m: `Σ Lᵢ cᵢ` over the trunk's
     /// segments, `cᵢ` the share of the trunk's length up to segment i's end (each segment
     /// turns by its share of the arc; L/2 for a smooth arc).
@@ -85,7 +87,7 @@ impl TrunkModel {
             return Self {
                 natural_frequency: 1.0,
                 tip_per_pascal: 0.0,
-                pressure_centre: 0.5,
+                damping_centre: crate::physics::beam::UNIFORM_CENTRE,
                 lever: 1.0,
                 damping_ratio: STRUCTURAL_DAMPING,
                 drag,
@@ -111,7 +113,7 @@ impl TrunkModel {
         Self {
             natural_frequency: modes.hz(0),
             tip_per_pascal: bend.tip[0],
-            pressure_centre: bend.pressure_centre[0],
+            damping_centre: bend.damping_centre[0],
             lever,
             damping_ratio: STRUCTURAL_DAMPING,
             drag: DragModel::default(),
@@ -126,11 +128,11 @@ impl TrunkModel {
     }
 
     /// Damping ratio in a wind of `u` m/s: the wood's plus the air's, `ω₀ c ρ δ' u g(u) / 2`
-    /// (δ' the tip's deflection per pascal, c the centre of pressure), as Skjermo's stems.
+    /// (δ' the tip's deflection per pascal, c the damping centre), as Skjermo's stems.
     pub fn damping(&self, u: f32) -> f32 {
         let w = std::f32::consts::TAU * self.natural_frequency;
         self.damping_ratio
-            + 0.5 * w * self.pressure_centre * AIR_DENSITY * self.tip_per_pascal * u * self.drag.reconfiguration(u)
+            + 0.5 * w * self.damping_centre * AIR_DENSITY * self.tip_per_pascal * u * self.drag.reconfiguration(u)
     }
 
     /// The oscillator's response to a wave of `f` Hz at damping ratio `zeta`: gain and

@@ -23,7 +23,7 @@ struct ZiomaTrunk {
     crown_centre: vec3<f32>,
     natural_frequency: f32,
     tip_per_pascal: f32,
-    pressure_centre: f32,
+    damping_centre: f32,
     lever: f32,
     damping_ratio: f32,
     reconfiguration_speed: f32,

@@ -30,7 +30,7 @@ fn static_bend(u: f32) -> f32 {
 fn trunk_damping(u: f32) -> f32 {
     let w = TAU * trunk.natural_frequency;
     return trunk.damping_ratio
-        + 0.5 * w * trunk.pressure_centre * AIR_DENSITY * trunk.tip_per_pascal * u * reconfiguration(u);
+        + 0.5 * w * trunk.damping_centre * AIR_DENSITY * trunk.tip_per_pascal * u * reconfiguration(u);
 }
 
 // The oscillator's gain and phase lag at f Hz (TrunkModel::response).
