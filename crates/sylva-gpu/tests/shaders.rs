@@ -346,6 +346,7 @@ fn animation_structs_match_their_wgsl_twins() {
             ("inertia", offset_of!(RawAkagiSegment, inertia)),
             ("stiffness", offset_of!(RawAkagiSegment, stiffness)),
             ("damping", offset_of!(RawAkagiSegment, damping)),
+            ("air_scale", offset_of!(RawAkagiSegment, air_scale)),
             ("_pad", offset_of!(RawAkagiSegment, _pad)),
         ],
     );

@@ -147,7 +147,8 @@ pub fn quat_from_rotation_vector(t: Vec3) -> Quat {
     Quat::from_axis_angle(t / a, a)
 }
 
-/// Damped angular springs advanced by the exact solution of `J θ̈ + (c + Γ) θ̇ + k θ = τ`
+/// Damped angular springs advanced by the exact solution of `J θ̈ + (c + s Γ) θ̇ + k θ = τ`
+/// (`s` the joint's [`RawAkagiSegment::air_scale`])
 /// over the step with the moment, stiffness and damping held (so frequency and damping do
 /// not depend on the step, and the air's damping Γ is stable at any wind). The spring
 /// stiffens with the bend the moment holds it at ([`stiffening`]); its damping ratio stays. τ is the moment of
@@ -183,7 +184,7 @@ pub fn akagi_integrate(
             let w0 = Vec3::new(om[0], om[1], om[2]);
             let stiffen = stiffening(tau.length() / a.stiffness, step.stiffening_angle);
             let k = a.stiffness * stiffen;
-            let c = a.damping * stiffen.sqrt() + gamma;
+            let c = a.damping * stiffen.sqrt() + gamma * a.air_scale;
             let (mut t1, mut w1) = damped_step(t0, w0, tau / k, k / a.inertia, c / (2.0 * a.inertia), step.dt);
             // A hard stop at three stiffening angles: the bend goes no further and stops
             // moving outward.

@@ -18,8 +18,12 @@ pub struct RawAkagiSegment {
     pub stiffness: f32,
     /// Structural damping `c = 2 ζ √(k J)`, N·m·s/rad.
     pub damping: f32,
+    /// Factor on the air's damping Γ of turning about the joint, `J / J_rigid`: the modal
+    /// inertia over the inertia of everything beyond the joint swinging about it, so the air
+    /// damps the joint's ring as it damps that swing, `Γ / (2 J_rigid ω)`.
+    pub air_scale: f32,
     /// Padding.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
 }
 
 /// Per-step values, 32 bytes. WGSL: `AkagiStep` in `akagi.wgsl`.

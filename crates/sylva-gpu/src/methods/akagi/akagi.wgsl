@@ -7,7 +7,8 @@ struct AkagiSegment {
     inertia: f32,
     stiffness: f32,
     damping: f32,
-    _pad: array<u32, 3>,
+    air_scale: f32,
+    _pad: array<u32, 2>,
 }
 
 struct AkagiStep {

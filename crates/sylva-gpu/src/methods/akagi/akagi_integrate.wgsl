@@ -39,7 +39,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let w0 = omega[i].xyz;
     let stiffen = stiffening(length(tau) / a.stiffness, step.stiffening_angle);
     let k = a.stiffness * stiffen;
-    let c = a.damping * sqrt(stiffen) + gamma;
+    let c = a.damping * sqrt(stiffen) + gamma * a.air_scale;
     // The exact step of x'' + 2 a x' + w2 (x - x_eq) = 0 (physics::oscillator::damped_step).
     let w2 = k / a.inertia;
     let damp = c / (2.0 * a.inertia);
