@@ -1226,7 +1226,7 @@ fn every_method_streamlines_in_strong_wind() {
 fn the_whole_tree_frame_rings_a_uniform_cantilever_at_its_first_two_beam_modes() {
     use sylva_core::physics::frame::{modes, sway_mode};
     let t = cantilever();
-    let m = modes(&t, 0.0, 4);
+    let m = modes(&t, 0.0, 4).unwrap();
     let f1 = beam_frequency(&t);
     let f2 = f1 * (4.694f32 / 1.875).powi(2);
     let found: Vec<(f32, f32)> = m.iter().map(|x| (x.hz, x.horizontal_share())).collect();
@@ -1246,8 +1246,10 @@ fn the_whole_tree_frame_rings_a_uniform_cantilever_at_its_first_two_beam_modes()
 fn the_frames_modes_do_not_depend_on_the_thread_count() {
     use sylva_core::physics::{MIN_RADIUS, frame::modes};
     let t = small_aspen();
-    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(|| modes(&t, MIN_RADIUS, 6));
-    let many = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap().install(|| modes(&t, MIN_RADIUS, 6));
+    let one =
+        rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(|| modes(&t, MIN_RADIUS, 6).unwrap());
+    let many =
+        rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap().install(|| modes(&t, MIN_RADIUS, 6).unwrap());
     assert_eq!(one, many);
     let hz: Vec<f32> = one.iter().map(|m| m.hz).collect();
     println!("small aspen's lowest frame modes {hz:?} Hz");
@@ -1265,7 +1267,7 @@ fn the_frames_sway_mode_rings_at_the_shared_beams_trunk_frequency() {
         frame::{modes, sway_mode},
     };
     let t = small_aspen();
-    let m = modes(&t, MIN_RADIUS, 12);
+    let m = modes(&t, MIN_RADIUS, 12).unwrap();
     let sway = sway_mode(&m).unwrap();
     let beam = stem_frequencies(&t, MIN_RADIUS).hz(0);
     let found: Vec<(f32, f32)> = m.iter().map(|x| (x.hz, x.horizontal_share())).collect();
@@ -1286,10 +1288,32 @@ fn a_cantilever_drawn_as_one_segment_rings_in_the_frame_at_the_beam_formula() {
         .generate(&LSystemOptions::default())
         .unwrap();
     assert_eq!(t.segments.len(), 1);
-    let f = modes(&t, 0.0, 2)[0].hz;
+    let f = modes(&t, 0.0, 2).unwrap()[0].hz;
     let beam = beam_frequency(&t);
     println!("one 5 m segment: frame {f} Hz, beam formula {beam} Hz");
     assert!((f / beam - 1.0).abs() < 0.02, "frame {f} Hz, beam formula {beam} Hz");
+}
+
+/// The frame's modes hold every piece of the tree in several bends at once and three blocks
+/// of shapes (about 6 KB a segment): `sylva fidelity` on a species file of a million segments
+/// would have taken gigabytes. A tree one segment over `frame::MAX_SEGMENTS` is refused, at
+/// once, with an error that names the limit and the tree's count.
+#[test]
+fn the_frames_modes_refuse_a_tree_over_their_segment_limit_and_say_so() {
+    use sylva_core::physics::frame::{MAX_SEGMENTS, TooLarge, modes};
+    let n = MAX_SEGMENTS + 1;
+    let axiom = "!(1)".to_string() + &"F(0.001)".repeat(n);
+    let t = Grammar::parse(&format!("width-scale: 0.04\naxiom: {axiom}\n"), "long.lsys")
+        .unwrap()
+        .generate(&LSystemOptions::default())
+        .unwrap();
+    assert_eq!(t.segments.len(), n);
+    let started = std::time::Instant::now();
+    let err = modes(&t, 0.0, 2).unwrap_err();
+    assert_eq!(err, TooLarge { segments: n, limit: MAX_SEGMENTS });
+    let message = err.to_string();
+    println!("{message} ({:?})", started.elapsed());
+    assert!(message.contains(&n.to_string()) && message.contains("MAX_SEGMENTS"), "{message}");
 }
 
 /// The air's damping of a stem's mode weighs each part's drag by how far it moves with the

@@ -132,9 +132,13 @@ pub struct TreeFigures {
     pub sway_share: f32,
 }
 
-/// The figures of `t` that do not depend on the method.
+/// The figures of `t` that do not depend on the method. A tree too large for the frame's
+/// modes ([`frame::MAX_SEGMENTS`]) gets no sway mode, and a warning saying why.
 pub fn tree_figures(t: &Tree) -> TreeFigures {
-    let modes = frame::modes(t, physics::MIN_RADIUS, FRAME_MODES);
+    let modes = frame::modes(t, physics::MIN_RADIUS, FRAME_MODES).unwrap_or_else(|e| {
+        eprintln!("warning: the frame's sway mode is left out: {e}");
+        Vec::new()
+    });
     let sway = frame::sway_mode(&modes);
     let sway_share = sway.map_or(0.0, |m| m.horizontal_share());
     TreeFigures { leans: beam_leans(t), sway_hz: sway.filter(|_| sway_share >= SWAY_SHARE).map(|m| m.hz), sway_share }

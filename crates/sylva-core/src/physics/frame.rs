@@ -57,14 +57,37 @@ impl FrameMode {
     }
 }
 
+/// Largest tree whose modes [`modes`] finds, in segments. Every block iteration bends the
+/// whole frame under each of its trial loads (several at once, each bend holding every
+/// piece's turn, shift and curvature) and keeps three blocks of shapes: the 30,197-segment
+/// weeping willow peaks at 180 MB on two threads, about 6 KB a segment.
+pub const MAX_SEGMENTS: usize = 100_000;
+
+/// [`modes`] asked of a tree over [`MAX_SEGMENTS`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "the tree has {segments} segments; the whole tree's modes are found for at most {limit} \
+     (physics::frame::MAX_SEGMENTS, about 6 KB a segment)"
+)]
+pub struct TooLarge {
+    /// Segments of the tree.
+    pub segments: usize,
+    /// [`MAX_SEGMENTS`].
+    pub limit: usize,
+}
+
 /// The `count` lowest natural modes of `tree` as a frame (fewer where it has fewer parts),
 /// lowest first, with sections never thinner than their [`super::section_floor`] over
 /// `min_radius` (m). Each segment's mass moves in as many parts (1, 2, 4 or [`PIECES`]) as
 /// keep each part within [`PART_OF_HEIGHT`] of the tree's height. Deterministic: the trial
-/// shapes come from a fixed seed and are bent in parallel but summed in order.
-pub fn modes(tree: &Tree, min_radius: f32, count: usize) -> Vec<FrameMode> {
+/// shapes come from a fixed seed and are bent in parallel but summed in order. A tree over
+/// [`MAX_SEGMENTS`] is refused before anything is allocated.
+pub fn modes(tree: &Tree, min_radius: f32, count: usize) -> Result<Vec<FrameMode>, TooLarge> {
     let s = &tree.segments;
     let n = s.len();
+    if n > MAX_SEGMENTS {
+        return Err(TooLarge { segments: n, limit: MAX_SEGMENTS });
+    }
     let span = PART_OF_HEIGHT * tree.height().max(f32::MIN_POSITIVE);
     // The parts: segment, first piece, pieces; and each part's mass.
     let mut parts: Vec<(usize, usize, usize)> = Vec::new();
@@ -80,7 +103,7 @@ pub fn modes(tree: &Tree, min_radius: f32, count: usize) -> Vec<FrameMode> {
     let dofs = parts.len();
     let count = count.min(dofs);
     if count == 0 {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     let frame = Frame::new(tree, min_radius);
     let total: f64 = mass.iter().sum();
@@ -163,7 +186,7 @@ pub fn modes(tree: &Tree, min_radius: f32, count: usize) -> Vec<FrameMode> {
             x.push(random());
         }
     }
-    x.iter()
+    Ok(x.iter()
         .zip(&lambda)
         .take(count)
         .map(|(shape, &l)| {
@@ -182,7 +205,7 @@ pub fn modes(tree: &Tree, min_radius: f32, count: usize) -> Vec<FrameMode> {
                 shape: mean.iter().map(|u| u.as_vec3()).collect(),
             }
         })
-        .collect()
+        .collect())
 }
 
 /// The mode a tree sways in: of `modes`, the one that swings the most of its mass horizontally
