@@ -83,7 +83,7 @@ pub struct DragBend {
 }
 
 /// [`DragBend::damping_centre`] of a uniform load on a uniform cantilever, `∫φ² / ∫φ` with
-/// `φ(ξ) = (ξ⁴ − 4ξ³ + 6ξ²) / 3`: the weight of a stem that does not bend.
+/// `φ(ξ) = (ξ⁴ − 4ξ³ + 6ξ²) / 3`: the weight given to a stem with no load or no bend.
 pub const UNIFORM_CENTRE: f32 = 52.0 / 81.0;
 
 /// How a stem's beam carries the stems that grow from it.

@@ -21,9 +21,10 @@
 //!    `c = 2 ζ √(k J)` (structural damping) is advanced by its exact solution over the step,
 //!    so frequency and damping do not depend on the step. The air damps the joint as it
 //!    would damp everything beyond it swinging about it, `Γ / (2 J_rigid ω)`: `s = J /
-//!    J_rigid`, the modal inertia over that swing's (`J` stands for the stem's frequency on
-//!    a short, stiff joint and is several times `J_rigid`; without `s` a uniform cantilever
-//!    in 20 segments took about a ninth of the air's damping, less the finer it was cut). θ is a rotation vector in the
+//!    J_rigid`, the modal inertia over that swing's. `J` gives a short, stiff joint its
+//!    stem's frequency and is not that swing's inertia (at the base of a uniform cantilever
+//!    in 20 segments, five times it; met with `J`, Γ damped that cantilever about a ninth as
+//!    much as the air does, and less the finer it was cut). θ is a rotation vector in the
 //!    parent's rest frame; the spring stiffens as `k (1 + (|θ|/θ_s)²)` at the bend the
 //!    moment holds it at, and stops at `3 θ_s`, so joints do not spin through large angles.
 //! 4. **Pose**: rotations `δ = exp(θ)` applied root to tip through the seam.
