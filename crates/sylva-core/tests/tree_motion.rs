@@ -272,27 +272,23 @@ fn hsm_damping_is_in_the_field_range_and_rises_with_wind() {
 
 /// HSM's `drag_scale` (3) also tripled the air's damping, and its ζ passed 0.2 at 15 m/s on
 /// the 16 and 21 m aspens. The drag's scales (the calibration's and `drag_scale`) carry the
-/// load only: the lean in a steady wind is the same with the air's damping at its default
-/// or at the scales (±1 %), and the ring is damped less. At its default (`air_damping` 3)
-/// the trunk rings down at 15 m/s as the continuous beam's does (Skjermo's ζ, ±20 %;
-/// measured 0.080 against 0.095; at 2, 0.067).
+/// load only: doubling `drag_scale` doubles the lean in a steady wind (±10 %) and leaves the
+/// ring's damping as it was (±10 %). At its default (`air_damping` 1, weighed by the
+/// calibration's `air_scale`) the trunk rings down at 15 m/s as the continuous beam's does
+/// (Skjermo's ζ, ±20 %; measured 0.087 against 0.095; unweighed, 0.054).
 #[test]
 fn hsm_drag_scale_scales_the_load_not_the_air_damping() {
     let t = small_aspen();
-    let with = |air_damping: f32| {
-        let m = Hsm::new(&t, HsmParams { air_damping, ..Default::default() }).unwrap();
-        let scales = m.params.drag_scale * m.layout.load_scale;
-        (step_response(&m, &t, 15.0, 0.05), scales)
+    let with = |drag_scale: f32| {
+        let m = Hsm::new(&t, HsmParams { drag_scale, ..Default::default() }).unwrap();
+        step_response(&m, &t, 15.0, 0.05)
     };
     let p = HsmParams::default();
-    let ((lean, z), scales) = with(p.air_damping);
-    assert!(scales > p.air_damping, "the drag's scales {scales} do not exceed the air damping {}", p.air_damping);
-    let ((lean_scaled, z_scaled), _) = with(scales);
-    println!(
-        "lean {lean:.4} m, ζ {z:.3}; with the air's damping scaled too ({scales:.2}): lean {lean_scaled:.4} m, ζ {z_scaled:.3}"
-    );
-    assert!((lean / lean_scaled - 1.0).abs() < 0.01, "lean {lean} m against {lean_scaled} m");
-    assert!(z < 0.8 * z_scaled, "ζ {z} against {z_scaled} with the scales on the damping");
+    let (lean, z) = with(p.drag_scale);
+    let (lean_doubled, z_doubled) = with(2.0 * p.drag_scale);
+    println!("lean {lean:.4} m, ζ {z:.3}; with twice the drag scale: lean {lean_doubled:.4} m, ζ {z_doubled:.3}");
+    assert!((lean_doubled / lean / 2.0 - 1.0).abs() < 0.1, "lean {lean_doubled} m against {lean} m");
+    assert!((z_doubled / z - 1.0).abs() < 0.1, "ζ {z_doubled} against {z}");
     let (_, beam) = step_response(&Skjermo::new(&t, SkjermoParams::default()), &t, 15.0, 0.05);
     println!("ζ at 15 m/s: HSM {z:.3}, the beam (Skjermo) {beam:.3}");
     assert!((z / beam - 1.0).abs() <= 0.2, "HSM's ζ {z} against the beam's {beam} at 15 m/s");
@@ -1319,11 +1315,12 @@ fn the_frames_modes_refuse_a_tree_over_their_segment_limit_and_say_so() {
 /// The air's damping of a stem's mode weighs each part's drag by how far it moves with the
 /// mode, squared (`DragBend::damping_centre`). Along a uniform cantilever the drag's damping
 /// per metre, `c = ρ C_d 2r u g(u)`, and the mass per metre, `m = ρ_w π r²`, are the same
-/// everywhere, so any mode's air damping ratio is `c / (2 m ω)` whatever its shape. Skjermo's
-/// and Akagi's rings in a steady wind are damped by the wood's ratio plus that (±10 %), and
-/// Zioma's trunk model says the same (±3 %). Weighed by the mean of the shape, as they were,
-/// Zioma's and Skjermo's air part was 0.62 of it; Akagi, whose joints met the air's damping
-/// with their modal inertia, took about a ninth.
+/// everywhere, so any mode's air damping ratio is `c / (2 m ω)` whatever its shape. Skjermo's,
+/// Akagi's and HSM's rings in a steady wind are damped by the wood's ratio plus that (±10 %),
+/// and Zioma's trunk model says the same (±3 %). Weighed by the mean of the shape, as they
+/// were, Zioma's and Skjermo's air part was 0.62 of it; Akagi, whose joints met the air's
+/// damping with their modal inertia, took about a ninth; HSM, whose air damping was a
+/// factor (3) tuned on the aspen, three times it.
 #[test]
 fn the_air_damps_a_uniform_cantilevers_mode_as_the_continuous_beam() {
     use sylva_core::methods::zioma::trunk::TrunkModel;
@@ -1335,19 +1332,23 @@ fn the_air_damps_a_uniform_cantilevers_mode_as_the_continuous_beam() {
     let skjermo = Skjermo::new(&t, SkjermoParams::default());
     let akagi = Akagi::new(&t, AkagiParams::default());
     let zioma = TrunkModel::for_tree(&t, BRANCH_DRAG, LEAF_DRAG);
+    let hsm = hsm(&t);
     for u in [6.0f32, 10.0, 15.0, 20.0] {
         let c = AIR_DENSITY * BRANCH_DRAG * 2.0 * r * u * DragModel::default().reconfiguration(u);
         let want = c / (2.0 * mass * w);
         let (_, z) = step_response(&skjermo, &t, u, 0.05);
         let (_, za) = step_response(&akagi, &t, u, 0.05);
+        let (_, zh) = step_response(&hsm, &t, u, 0.05);
         let model = zioma.damping(u) - STRUCTURAL_DAMPING;
         println!(
-            "{u} m/s: the air's ζ {want:.4}; Skjermo rings at {:.4}, Akagi at {:.4}, Zioma's model {model:.4}",
+            "{u} m/s: the air's ζ {want:.4}; Skjermo rings at {:.4}, Akagi at {:.4}, HSM at {:.4}, Zioma's model {model:.4}",
             z - STRUCTURAL_DAMPING,
-            za - STRUCTURAL_DAMPING
+            za - STRUCTURAL_DAMPING,
+            zh - STRUCTURAL_DAMPING
         );
         assert!(((z - STRUCTURAL_DAMPING) / want - 1.0).abs() < 0.1, "{u} m/s: Skjermo {z}, the air's {want}");
         assert!(((za - STRUCTURAL_DAMPING) / want - 1.0).abs() < 0.1, "{u} m/s: Akagi {za}, the air's {want}");
+        assert!(((zh - STRUCTURAL_DAMPING) / want - 1.0).abs() < 0.1, "{u} m/s: HSM {zh}, the air's {want}");
         assert!((model / want - 1.0).abs() < 0.03, "{u} m/s: Zioma's model {model}, the air's {want}");
     }
 }

@@ -42,6 +42,14 @@
 //!    leaders reach), but held by the trunk it rings with the tree: the oak's leaders'
 //!    tops lean 1.69 % against the trunk's 1.67 %, and after the wind stops their mean
 //!    rings at 0.85 Hz against the trunk's 0.865 Hz from the wood.
+//! 6. The air's damping ([`air_scale`]): the hold moves a held ring as if it were heavier
+//!    (`Σ w / hold` times), so the trunk's mode carries its inertia where the rings are
+//!    held, while the drag damps where its area is. On the small aspen (6 m) that weighs
+//!    the mode's inertia 32 times the wood's and the drag's damping 9 times (the leaves
+//!    ride on twigs the hold keeps less), and the trunk rang at 0.25 of the air's damping
+//!    of the beam; on a bare uniform cantilever both weigh alike. The air's damping is
+//!    scaled by the ratio, so the trunk's mode meets the air as the particles' own masses
+//!    would.
 
 use super::raw::kind;
 use super::{FIXED, Hsm};
@@ -116,7 +124,7 @@ pub fn trunk_frequency(tree: &Tree, hsm: &Hsm) -> Option<f32> {
 /// [`trunk_frequency`], giving up after `longest` seconds.
 fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<f32> {
     let (mut best, mut at) = (0.0f32, 0usize);
-    trunk_run(tree, hsm, longest, None, Top::Ring, |x, h| {
+    trunk_run(tree, hsm, longest, None, Top::Ring, |x, h, _| {
         let (i, xi) = (x.len() - 1, x[x.len() - 1]);
         if xi > best {
             (best, at) = (xi, i);
@@ -130,13 +138,22 @@ fn trunk_pluck(tree: &Tree, hsm: &Hsm, longest: f32) -> Option<f32> {
 /// The trunk top's static lean under the drag of a steady wind of `speed` m/s along x, m:
 /// the mean displacement of its end in the pose ([`Top::Pose`]) over `window` seconds from
 /// rest (quadratic drag, without the air's damping or reconfiguration: a step load,
-/// undamped). A lone mode swings about its lean as `1 − cos ωt`, whose mean over whole
+/// undamped), and each particle's mean x displacement over the same run, the lean's shape.
+/// A lone mode swings about its lean as `1 − cos ωt`, whose mean over whole
 /// periods is the lean; the first peak, twice the lean for a lone mode, is a crown's own
 /// quicker swing where the trunk hands its load to heavy leaders (on the black oak's sapling
 /// with forks that share the section, half that peak was a 194th of the lean).
-fn static_lean(tree: &Tree, hsm: &Hsm, window: f32, speed: f32) -> Option<f32> {
-    trunk_run(tree, hsm, window, Some(speed), Top::Pose, |x, h| {
-        ((x.len() + 1) as f32 * h > window).then(|| x.iter().map(|&v| v as f64).sum::<f64>() as f32 / x.len() as f32)
+fn static_lean(tree: &Tree, hsm: &Hsm, window: f32, speed: f32) -> Option<(f32, Vec<f32>)> {
+    let mut shape = vec![0.0f64; hsm.layout.rest.len()];
+    trunk_run(tree, hsm, window, Some(speed), Top::Pose, |x, h, state| {
+        for (sum, u) in shape.iter_mut().zip(&state.displacement) {
+            *sum += u[0] as f64;
+        }
+        ((x.len() + 1) as f32 * h > window).then(|| {
+            let n = x.len() as f64;
+            let lean = x.iter().map(|&v| v as f64).sum::<f64>() / n;
+            (lean as f32, shape.iter().map(|s| (s / n) as f32).collect())
+        })
     })
 }
 
@@ -194,8 +211,8 @@ fn chain_end(chain: &[(usize, Vec3)], state: &super::HsmState) -> Vec3 {
 
 /// Steps `hsm` from rest under `LOAD` (`speed` `None`) or under the drag of a steady wind of
 /// `speed` m/s along x, for at most `longest` seconds, handing the trunk top's x
-/// displacement so far, read `at` it (one entry per substep), and the substep to `read`
-/// after each substep until it answers. `None` without a substep rate, without a trunk
+/// displacement so far, read `at` it (one entry per substep), the substep and the state to
+/// `read` after each substep until it answers. `None` without a substep rate, without a trunk
 /// cluster, on a non-finite displacement, or when `read` has not answered in time.
 fn trunk_run<T>(
     tree: &Tree,
@@ -203,7 +220,7 @@ fn trunk_run<T>(
     longest: f32,
     speed: Option<f32>,
     at: Top,
-    mut read: impl FnMut(&[f32], f32) -> Option<T>,
+    mut read: impl FnMut(&[f32], f32, &super::HsmState) -> Option<T>,
 ) -> Option<T> {
     let rate = substep_rate(hsm);
     if rate <= 0.0 || tree.stems.is_empty() {
@@ -244,7 +261,7 @@ fn trunk_run<T>(
             return None;
         }
         x.push(xi);
-        if let Some(v) = read(&x, h) {
+        if let Some(v) = read(&x, h, &state) {
             return Some(v);
         }
     }
@@ -512,7 +529,7 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
         .collect();
     // A lean as built, once the rates are scaled and without the drag's own scale.
     let calibrated = (f0 / target).powi(2) / hsm.params.drag_scale.max(f32::MIN_POSITIVE);
-    trunk_drag(tree, hsm, f0, calibrated, bends[TRUNK]);
+    let mut shape = trunk_drag(tree, hsm, f0, calibrated, bends[TRUNK]);
     // 5. The leaders a forked trunk grows: under the loads that lean the trunk as its beam,
     // each stiffened until it leans as its own (see the module docs), then the trunk's
     // frequency and drag once more.
@@ -531,9 +548,13 @@ pub fn calibrate(tree: &Tree, hsm: &mut Hsm) {
             .collect();
         hsm.layout.scale_stem_rates(tree, &factors);
         trunk_back(tree, hsm, f0, 1);
-        trunk_drag(tree, hsm, f0, calibrated, bends[TRUNK]);
+        shape = trunk_drag(tree, hsm, f0, calibrated, bends[TRUNK]).or(shape);
     }
     hsm.layout.scale_rates((target / f0).powi(2).clamp(1e-4, 1e4));
+    // 6. The air's damping, weighed as the calibrated trunk's mode moves its inertia.
+    if let Some(shape) = shape {
+        hsm.layout.air_scale = air_scale(hsm, &shape);
+    }
 }
 
 /// Brings the trunk's pluck back to `f0` by scaling its rates, in at most `passes` passes: a
@@ -558,11 +579,49 @@ fn trunk_back(tree: &Tree, hsm: &mut Hsm, f0: f32, passes: usize) {
 
 /// Scales every particle's drag so the trunk top's static lean in a steady wind, as built
 /// and read as `calibrated` times the run's, is `beam` (m, the beam's under the same drag).
-fn trunk_drag(tree: &Tree, hsm: &mut Hsm, f0: f32, calibrated: f32, beam: f32) {
-    if let Some(mean) = static_lean(tree, hsm, LEAN_PERIODS / f0, CALM) {
-        let lean = mean * calibrated;
-        if lean > 0.0 && beam > 0.0 && (lean * beam).is_finite() {
-            hsm.layout.scale_loads((beam / lean).clamp(LOAD_FACTOR.0, LOAD_FACTOR.1));
-        }
+/// The lean's shape, each particle's mean x displacement (see [`static_lean`]), for step 6.
+fn trunk_drag(tree: &Tree, hsm: &mut Hsm, f0: f32, calibrated: f32, beam: f32) -> Option<Vec<f32>> {
+    let (mean, shape) = static_lean(tree, hsm, LEAN_PERIODS / f0, CALM)?;
+    let lean = mean * calibrated;
+    if lean > 0.0 && beam > 0.0 && (lean * beam).is_finite() {
+        hsm.layout.scale_loads((beam / lean).clamp(LOAD_FACTOR.0, LOAD_FACTOR.1));
     }
+    Some(shape)
+}
+
+/// Step 6: the factor on the air's damping that gives the trunk's mode, in the shape
+/// `shape` (each particle's displacement), the air's damping ratio it has with the
+/// particles' own masses ([`super::HsmLayout::air_scale`]). The drag's damping is each
+/// particle's `m k_d`; where the hold keeps a particle (`Σ w > hold`, the weights of the
+/// layout as it stands at its own substep) it moves as if its mass were `μ = m Σ w / hold`,
+/// so the mode's damping ratio is `Σ μ k_d φ² / (2 ω Σ μ φ²)` where the tree's is
+/// `Σ m k_d φ² / (2 ω Σ m φ²)`. Particles that move with the tree but do not push back on it
+/// (leaf blades without [`super::HsmParams::leaf_reaction`]) and fixed ones are left out. 1
+/// where either sum vanishes.
+fn air_scale(hsm: &Hsm, shape: &[f32]) -> f32 {
+    let l = &hsm.layout;
+    let h = 1.0 / substep_rate(hsm);
+    let hold = hsm.hold(h);
+    let (mut inertia, mut held_inertia, mut damping, mut held_damping) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for (i, &phi) in shape.iter().enumerate() {
+        if l.free[i] == 0.0 || (l.info[l.owner[i] as usize].kind == kind::LEAF && !hsm.params.leaf_reaction) {
+            continue;
+        }
+        let weight: f32 = l.member[l.member_offset[i] as usize..l.member_offset[i + 1] as usize]
+            .iter()
+            .map(|m| {
+                let c = &l.clusters[m.cluster as usize];
+                (c.rest_cm[3] * h * h).min((c.aqq_inv[0][3] * h * h).max(hold)).min(super::kernels::MAX_WEIGHT)
+            })
+            .sum();
+        let held = (weight / hold).max(1.0) as f64;
+        let (m, phi2) = (l.mass[i] as f64, phi as f64 * phi as f64);
+        let c = m * l.rest[i][3].max(0.0) as f64;
+        inertia += m * phi2;
+        held_inertia += held * m * phi2;
+        damping += c * phi2;
+        held_damping += held * c * phi2;
+    }
+    let scale = (held_inertia / inertia) / (held_damping / damping);
+    if scale.is_finite() && scale > 0.0 { (scale as f32).clamp(LOAD_FACTOR.0, LOAD_FACTOR.1) } else { 1.0 }
 }

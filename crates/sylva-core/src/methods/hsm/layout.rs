@@ -41,6 +41,13 @@ pub struct HsmLayout {
     /// Factor on every particle's drag since it was derived from the air: the calibrated
     /// trunk's static compliance over the beam's ([`super::calibrate`]); 1 as built.
     pub load_scale: f32,
+    /// Factor on the air's damping so that the trunk's mode meets it as the tree's would:
+    /// the hold moves a held particle as if its mass were `Σ w / hold` times its own, so the
+    /// mode's inertia lies where the rings are held, while the drag's damping lies where its
+    /// area is. The factor is the mode's inertia so inflated over the drag's damping so
+    /// weighed, each over its sum with the particles' own masses, in the shape of the trunk's
+    /// static lean ([`super::calibrate`], step 6); 1 as built.
+    pub air_scale: f32,
     /// The trunk's first-mode frequency from the wood, Hz ([`crate::physics::stem_frequencies`]).
     pub sway_hz: f32,
     /// Factor on the drag of the leaves and side stems, 0–1, so that the crown drags no more
@@ -106,6 +113,7 @@ impl HsmLayout {
                 max_children: 0,
                 rate_scale: 1.0,
                 load_scale: 1.0,
+                air_scale: 1.0,
                 sway_hz: crate::physics::stem_frequencies(tree, params.min_radius).hz(0),
                 shelter: crate::physics::crown_shelter(tree, params.drag, params.leaf_drag),
             },

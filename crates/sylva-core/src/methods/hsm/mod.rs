@@ -84,7 +84,8 @@
 //! plucked when the method is built, sways at its first mode from
 //! [`crate::physics::stem_frequencies`], and each side stem, plucked with its parent held,
 //! at its own (a factor on its clusters' rates besides `s`). Damping is a ratio of the
-//! trunk's mode ([`HsmParams::damping_ratio`]); the drag adds the air's.
+//! trunk's mode ([`HsmParams::damping_ratio`]); the drag adds the air's, weighed by the
+//! inertia the hold gives the trunk's mode ([`HsmLayout::air_scale`]).
 //!
 //! **Rotation**: `R` is extracted by the iterative method of Müller, Bender, Chentanez &
 //! Macklin (2016), warm-started from the last step's R, `R ← rot(ω) R` (the unit
@@ -301,7 +302,11 @@ impl Hsm {
             hold: self.hold(dt),
             reconfiguration_speed: p.reconfiguration_speed,
             vogel_exponent: p.vogel_exponent,
-            air: if p.drag_scale > 0.0 { p.air_damping / (p.drag_scale * self.layout.load_scale) } else { 1.0 },
+            air: if p.drag_scale > 0.0 {
+                p.air_damping * self.layout.air_scale / (p.drag_scale * self.layout.load_scale)
+            } else {
+                1.0
+            },
             sample_wind: 1,
             leaf_turbulence: p.leaf_turbulence * self.leaf_motion.crown_wind,
             flutter_onset: self.leaf_motion.flutter_onset / self.leaf_motion.crown_wind.max(f32::MIN_POSITIVE),

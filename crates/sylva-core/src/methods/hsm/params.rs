@@ -80,15 +80,15 @@ pub struct HsmParams {
     /// quaking_aspen`). It scales the drag's load, not the air's damping (see
     /// [`Self::air_damping`]).
     pub drag_scale: f32,
-    /// The air's damping, as a factor on that of the drag without [`Self::drag_scale`] or the
-    /// calibration's scale: a particle's drag is `kd |r| r` on the relative velocity
-    /// `r = wind − (air_damping / scales) v`, so the load in still parts is the scaled drag's
-    /// and the drag's change with the particle's own velocity (`∂F/∂v`, the aerodynamic
-    /// damping) is `air_damping` times the sheltered drag's. Default 3: the trunk rings down
-    /// in wind near the continuous beam's (Skjermo's, whose air damping weighs each part by
-    /// how far it moves with the mode): on the small aspen (12.3 m) ζ at 15 m/s is 0.080
-    /// against the beam's 0.095 (0.067 with 2). With 5 the aspen's size series rang at ζ
-    /// 0.13–0.14 and the twigs of its 21 m tree kept only 9.9 % of their motion above 1.5 Hz.
+    /// Factor on the air's damping: a particle's drag is `kd |r| r` on the relative
+    /// velocity `r = wind − a v`, `a` this factor times the calibration's
+    /// [`super::HsmLayout::air_scale`] over the drag's scales ([`Self::drag_scale`] and the
+    /// calibration's), so the load in still parts is the scaled drag's and the drag's change
+    /// with the particle's own velocity (`∂F/∂v`, the aerodynamic damping) is the sheltered
+    /// drag's, weighed so the trunk's mode meets it as the wood and leaves would. Default 1:
+    /// a uniform cantilever rings at the continuous beam's air damping `c / (2 m ω)` (as
+    /// Akagi, Skjermo and Zioma do); the small aspen's trunk at ζ 0.087 at 15 m/s against the
+    /// beam's 0.095.
     pub air_damping: f32,
     /// Speed around which bark and leaves streamline, m/s (see
     /// [`crate::physics::DragModel`]; default 5, as the other methods).
@@ -162,7 +162,7 @@ impl Default for HsmParams {
             drag: 0.8,
             leaf_drag: 0.05,
             drag_scale: 0.85,
-            air_damping: 3.0,
+            air_damping: 1.0,
             reconfiguration_speed: crate::physics::DragModel::default().reconfiguration_speed,
             vogel_exponent: crate::physics::DragModel::default().vogel_exponent,
             gravity: 9.81,

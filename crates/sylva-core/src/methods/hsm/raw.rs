@@ -131,7 +131,8 @@ pub struct RawHsmStep {
     /// [`super::HsmParams::vogel_exponent`].
     pub vogel_exponent: f32,
     /// The drag's relative velocity is `wind − air · v`: [`super::HsmParams::air_damping`]
-    /// over the drag's scales, [`super::HsmParams::drag_scale`] times the calibration's
+    /// times the calibration's [`super::HsmLayout::air_scale`] over the drag's scales,
+    /// [`super::HsmParams::drag_scale`] times the calibration's
     /// [`super::HsmLayout::load_scale`] (1 when the drag scale is 0).
     pub air: f32,
     /// 1: stage 1 samples the wind at the clusters' centres (the first substep of a step);
