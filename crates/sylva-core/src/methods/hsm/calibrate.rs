@@ -609,10 +609,7 @@ fn air_scale(hsm: &Hsm, shape: &[f32]) -> f32 {
         }
         let weight: f32 = l.member[l.member_offset[i] as usize..l.member_offset[i + 1] as usize]
             .iter()
-            .map(|m| {
-                let c = &l.clusters[m.cluster as usize];
-                (c.rest_cm[3] * h * h).min((c.aqq_inv[0][3] * h * h).max(hold)).min(super::kernels::MAX_WEIGHT)
-            })
+            .map(|m| super::kernels::cluster_weight(&l.clusters[m.cluster as usize], h, hold))
             .sum();
         let held = (weight / hold).max(1.0) as f64;
         let (m, phi2) = (l.mass[i] as f64, phi as f64 * phi as f64);

@@ -156,6 +156,14 @@ fn cluster_apq(cl: &RawHsmCluster, sums: [Vec3A; 4], sp: Vec3A) -> (Mat3, Vec3) 
     (Mat3::from_cols(a0, a1, a2), shift)
 }
 
+/// A cluster's weight at substep `h`: its `k h²`, past the hold only up to its path's `k̂ h²`
+/// (see [`MAX_WEIGHT`]). WGSL: `hsm_cluster_stage.wgsl`.
+#[inline(always)]
+pub(super) fn cluster_weight(cl: &RawHsmCluster, h: f32, hold: f32) -> f32 {
+    let bound = (cl.aqq_inv[0][3] * h * h).max(hold);
+    (cl.rest_cm[3] * h * h).min(bound).min(MAX_WEIGHT)
+}
+
 /// Stage 1 for one cluster after R (`q`): the goal transform, the weight `k h²` and the
 /// state, the wind aside.
 #[inline(always)]
@@ -177,9 +185,7 @@ fn finish_cluster(
             t = a * (step.beta / det.powf(1.0 / 3.0)) + r * (1.0 - step.beta);
         }
     }
-    // The cluster's weight k h², past the hold only up to its path's k̂ h² (see `MAX_WEIGHT`).
-    let bound = (cl.aqq_inv[0][3] * step.dt * step.dt).max(step.hold);
-    let weight = (cl.rest_cm[3] * step.dt * step.dt).min(bound).min(MAX_WEIGHT);
+    let weight = cluster_weight(cl, step.dt, step.hold);
     st.cm = [cm.x, cm.y, cm.z, weight];
     st.rotation = q.to_array();
     st.transform = [t.x_axis.extend(shift.x).into(), t.y_axis.extend(shift.y).into(), t.z_axis.extend(shift.z).into()];

@@ -97,7 +97,8 @@ fn hsm_finish_cluster(c: u32, sp: vec3<f32>, sums: HsmSums) {
             tr = a * (step.beta / pow(det, 1.0 / 3.0)) + r * (1.0 - step.beta);
         }
     }
-    // The cluster's weight k h², past 1 only up to its path's k̂ h² (see MAX_WEIGHT).
+    // The cluster's weight k h², past the hold only up to its path's k̂ h² (see MAX_WEIGHT;
+    // the CPU twin is cluster_weight in kernels.rs).
     let bound = max(cl.aqq_inv[0].w * step.dt * step.dt, step.hold);
     let weight = min(min(cl.rest_cm.w * step.dt * step.dt, bound), MAX_WEIGHT);
     state[c].cm = vec4<f32>(cm, weight);
