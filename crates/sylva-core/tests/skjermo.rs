@@ -202,7 +202,7 @@ fn every_instruction_set_level_gives_the_same_bits() {
     }
     let bits = |s: &[StateLanes]| -> Vec<u32> {
         s.iter()
-            .flat_map(|g| g.delta.iter().chain([&g.orient, &g.bend, &g.rate]).flat_map(|v| [v.x, v.y, v.z]))
+            .flat_map(|g| g.delta.iter().chain([&g.bend, &g.rate]).flat_map(|v| [v.x, v.y, v.z]))
             .flat_map(|v| v.to_array().map(f32::to_bits))
             .collect()
     };
@@ -252,7 +252,7 @@ fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
     }
     let bits = |s: &[StateLanes]| -> Vec<u32> {
         s.iter()
-            .flat_map(|g| g.delta.iter().chain([&g.orient, &g.bend, &g.rate]).flat_map(|v| [v.x, v.y, v.z]))
+            .flat_map(|g| g.delta.iter().chain([&g.bend, &g.rate]).flat_map(|v| [v.x, v.y, v.z]))
             .flat_map(|v| v.to_array().map(f32::to_bits))
             .collect()
     };

@@ -26,16 +26,15 @@ pub struct RawCurveStem {
     pub parent_orient: [f32; 4],
 }
 
-/// A stem's animated Bézier as the deformer reads it (Skjermo §3), 80 bytes: the
-/// displacement of each control point from rest and the stem's orientation vector O
-/// (xyz), handed to its children. WGSL: `SkjermoState` in `skjermo.wgsl`.
+/// A stem's animated Bézier as the deformer reads it (Skjermo §3), 64 bytes: the
+/// displacement of each control point from rest. Children re-attach by the parent's rest
+/// orientation vector (`RawCurveStem::parent_orient`) turned with its curve's tangent, so
+/// none is carried here. WGSL: `SkjermoState` in `skjermo.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RawStemCurve {
     /// Displacements of P0..P3 (xyz).
     pub delta: [[f32; 4]; 4],
-    /// Orientation vector O (xyz).
-    pub orient: [f32; 4],
 }
 
 /// A method's stems and their current curves, as the deformer reads them.

@@ -89,7 +89,6 @@ pub fn skjermo_step(
         d[2] += c2;
         d[3] += c2 + c3;
         out.delta = d.map(|v| v.extend(0.0).to_array());
-        out.orient = f_now[1].extend(0.0).to_array();
     });
 }
 

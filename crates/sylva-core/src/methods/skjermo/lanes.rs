@@ -142,16 +142,14 @@ pub fn coefficients(stems: &[StemLanes], dt: f32) -> Vec<OscLanes> {
         .collect()
 }
 
-/// Per-group state of sixteen stems: control-point displacements, orientation vectors and
-/// bend oscillators. In memory twenty-one lanes-of-sixteen, component after component
-/// (`delta[0].x` … `orient.z`, then `bend`, `rate`), which the AVX2 gather relies on.
+/// Per-group state of sixteen stems: control-point displacements and bend oscillators. In
+/// memory eighteen lanes-of-sixteen, component after component (`delta[0].x` … `delta[3].z`,
+/// then `bend`, `rate`), which the AVX2 gather relies on.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[repr(C)]
 pub struct StateLanes {
     /// Displacements of P0..P3 from rest.
     pub delta: [V3; 4],
-    /// Orientation vector O handed to children.
-    pub orient: V3,
     /// The tip's bend vector b₃, m.
     pub bend: V3,
     /// Its rate of change, m/s.
@@ -163,19 +161,11 @@ impl StateLanes {
     pub fn delta(&self, lane: usize, j: usize) -> Vec3 {
         self.delta[j].lane(lane)
     }
-    /// One stem's orientation vector.
-    pub fn orient(&self, lane: usize) -> Vec3 {
-        self.orient.lane(lane)
-    }
 }
 
-/// Builds the lane groups from the reference's per-stem constants; `rest_orient` gives each
-/// stem's rest orientation vector. Returns the groups and the rest state.
-pub fn build(
-    stems: &[RawSkjermoStem],
-    modes: &[RawSkjermoMode],
-    rest_orient: &[[f32; 4]],
-) -> (Vec<StemLanes>, Vec<StateLanes>) {
+/// Builds the lane groups from the reference's per-stem constants. Returns the groups and
+/// the rest state.
+pub fn build(stems: &[RawSkjermoStem], modes: &[RawSkjermoMode]) -> (Vec<StemLanes>, Vec<StateLanes>) {
     let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
     let groups = stems.len().div_ceil(LANES);
     let mut lanes = Vec::with_capacity(groups);
@@ -216,14 +206,13 @@ pub fn build(
             damping: V::from(ks.map(|k| k.map_or(0.0, |k| modes[k].damping))),
             aero: V::from(ks.map(|k| k.map_or(0.0, |k| modes[k].aero))),
         });
-        let orient = V3::from_lanes(ks.map(|k| k.map_or(Vec3::ZERO, |k| v(rest_orient[k]))));
-        state.push(StateLanes { delta: [V3::ZERO; 4], orient, bend: V3::ZERO, rate: V3::ZERO });
+        state.push(StateLanes { delta: [V3::ZERO; 4], bend: V3::ZERO, rate: V3::ZERO });
     }
     (lanes, state)
 }
 
 /// Floats in one [`StateLanes`].
-const STATE_FLOATS: usize = 21 * LANES;
+const STATE_FLOATS: usize = 18 * LANES;
 const _: () = assert!(std::mem::size_of::<StateLanes>() == STATE_FLOATS * 4);
 
 /// Gathers the parents' previous displacements for the sixteen lanes of a group (a trunk or
@@ -262,8 +251,8 @@ fn gather_avx2(parent: &[u32; LANES], prev: &[StateLanes]) -> [V3; 4] {
     for h in 0..2 {
         // SAFETY: AVX2 is enabled for this function. `parent` holds sixteen u32, read as two
         // unaligned halves of eight. A lane is gathered only where its parent is at most
-        // `last`, so its index `(p / 16) · 336 + p % 16 + 16 · component` lies inside `prev`
-        // (`prev` is `repr(C)`, twenty-one lanes-of-sixteen per group, of which the first
+        // `last`, so its index `(p / 16) · 288 + p % 16 + 16 · component` lies inside `prev`
+        // (`prev` is `repr(C)`, eighteen lanes-of-sixteen per group, of which the first
         // twelve, the displacements, are read); other lanes keep `c`'s defaults. Stores go to
         // `c`'s arrays, eight floats at offset 0 or 8.
         unsafe {
@@ -400,7 +389,6 @@ fn groups_at(
         // P0 and P1 only follow the attachment: written at once, so that fewer values stay
         // live across the wind.
         out.delta[0] = moved(shift, &df, st.local[0]);
-        out.orient = f_now[1];
         let d1 = moved(shift, &df, st.local[1]);
         out.delta[1] = d1;
         let d2 = moved(shift, &df, st.local[2]);

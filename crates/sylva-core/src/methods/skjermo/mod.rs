@@ -276,7 +276,7 @@ impl Skjermo {
                 _pad: 0.0,
             })
             .collect::<Vec<_>>();
-        let (lanes, rest_lanes) = lanes::build(&stems, &modes, &rest_orient);
+        let (lanes, rest_lanes) = lanes::build(&stems, &modes);
         Self {
             params,
             stems,
@@ -291,7 +291,7 @@ impl Skjermo {
 
     /// Rebuilds the fast path's lane groups from `stems` (after editing them).
     pub fn rebuild_lanes(&mut self) {
-        (self.lanes, self.rest_lanes) = lanes::build(&self.stems, &self.modes, &self.rest_orient);
+        (self.lanes, self.rest_lanes) = lanes::build(&self.stems, &self.modes);
     }
 
     /// Per-step values.
@@ -415,7 +415,7 @@ impl Method for Skjermo {
 
     fn rest_state(&self, tree: &Tree) -> SkjermoState {
         SkjermoState {
-            stems: self.rest_orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect(),
+            stems: vec![RawSkjermoState { delta: [[0.0; 4]; 4] }; self.stems.len()],
             sway: vec![RawSkjermoSway::zeroed(); self.stems.len()],
             steps: 0,
             time: 0.0,
@@ -435,10 +435,7 @@ impl Method for Skjermo {
         state.stems.par_iter_mut().zip(state.sway.par_iter_mut()).enumerate().for_each(|(k, (s, sw))| {
             let g = &lanes[k / LANES];
             let l = k % LANES;
-            *s = RawSkjermoState {
-                delta: [0, 1, 2, 3].map(|j| g.delta(l, j).extend(0.0).to_array()),
-                orient: g.orient(l).extend(0.0).to_array(),
-            };
+            *s = RawSkjermoState { delta: [0, 1, 2, 3].map(|j| g.delta(l, j).extend(0.0).to_array()) };
             *sw = RawSkjermoSway {
                 bend: g.bend.lane(l).extend(0.0).to_array(),
                 rate: g.rate.lane(l).extend(0.0).to_array(),

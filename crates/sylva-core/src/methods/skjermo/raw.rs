@@ -7,8 +7,8 @@ use bytemuck::{Pod, Zeroable};
 /// `SkjermoStem` in `skjermo.wgsl`.
 pub type RawSkjermoStem = crate::pose::RawCurveStem;
 
-/// Per-stem state (what ping-pongs): the stem's curve as displacements from rest and its
-/// orientation vector, 80 bytes. WGSL: `SkjermoState`.
+/// Per-stem state (what ping-pongs): the stem's curve as displacements from rest, 64 bytes.
+/// WGSL: `SkjermoState`.
 pub type RawSkjermoState = crate::pose::RawStemCurve;
 
 /// Per-stem oscillator constants of the second-order bend, 16 bytes. WGSL: `SkjermoMode`.

@@ -40,7 +40,7 @@ pub struct GpuSkjermo {
     current: usize,
     modes: wgpu::Buffer,
     sway: wgpu::Buffer,
-    /// The rest state as the device rounds it.
+    /// The rest state (every displacement zero).
     rest: Vec<RawSkjermoState>,
     /// Each stem's rest control points.
     rest_curves: Vec<[Vec3; 4]>,
@@ -66,8 +66,7 @@ impl GpuSkjermo {
             }
         }
         ctx.queue.write_buffer(&stems_buffer, 0, bytemuck::cast_slice(&stems));
-        let rest: Vec<RawSkjermoState> =
-            orient.iter().map(|o| RawSkjermoState { delta: [[0.0; 4]; 4], orient: *o }).collect();
+        let rest = vec![RawSkjermoState { delta: [[0.0; 4]; 4] }; method.stems.len()];
         let mut this = Self {
             leaves: GpuLeafFlutter::new(ctx, &method.leaves)?,
             step_kernel: Kernel::get(ctx, "skjermo_step"),

@@ -15,7 +15,6 @@ struct SkjermoStem {
 
 struct SkjermoState {
     delta: array<vec4<f32>, 4>,
-    orient: vec4<f32>,
 }
 
 struct SkjermoStep {

@@ -84,6 +84,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     for (var j = 0u; j < 4u; j++) {
         out.delta[j] = vec4<f32>(d[j], 0.0);
     }
-    out.orient = vec4<f32>(f_now.n, 0.0);
     next[k] = out;
 }
