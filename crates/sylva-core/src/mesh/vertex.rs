@@ -56,10 +56,14 @@ fn sign_not_zero(p: Vec2) -> Vec2 {
     Vec2::new(if p.x >= 0.0 { 1.0 } else { -1.0 }, if p.y >= 0.0 { 1.0 } else { -1.0 })
 }
 
-/// WGSL's `pack2x16snorm` rule for one component: ⌊0.5 + 32767 · clamp(x, −1, 1)⌋.
+/// WGSL's `pack2x16snorm` rule for one component: ⌊0.5 + 32767 · clamp(x, −1, 1)⌋. The
+/// floor is the truncation, less one where that rounded a negative value up: exact in this
+/// range, and inline, where `f32::floor` is a libm call on x86-64's baseline (no `roundps`).
 #[inline]
 fn snorm16(x: f32) -> u32 {
-    ((0.5 + 32767.0 * x.clamp(-1.0, 1.0)).floor() as i32 as u32) & 0xffff
+    let y = 0.5 + 32767.0 * x.clamp(-1.0, 1.0);
+    let t = y as i32;
+    (t - i32::from(t as f32 > y)) as u32 & 0xffff
 }
 
 /// `max(c / 32767, −1)`, as a `Snorm16` vertex attribute reads it.
@@ -106,6 +110,21 @@ mod tests {
         }
         assert!(worst < 1e-4, "largest octahedral error {worst} rad");
         assert_eq!(oct_decode(oct_encode(Vec3::ZERO)), Vec3::Z);
+    }
+
+    #[test]
+    fn snorm16_floors_as_f32_floor() {
+        let floor = |x: f32| ((0.5 + 32767.0 * x.clamp(-1.0, 1.0)).floor() as i32 as u32) & 0xffff;
+        let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+        // Every value whose scaled form is a whole or half step, their neighbours one ulp
+        // either side, the ends, the signed zeros and NaN.
+        let steps = (-65536..=65536).map(|k| k as f32 / 65534.0);
+        let edges = steps.flat_map(|x| [x, f32::from_bits(x.to_bits() + 1), f32::from_bits(x.to_bits().max(1) - 1)]);
+        let special = [0.0, -0.0, 1.0, -1.0, 1.5, -1.5, f32::MIN_POSITIVE, -f32::MIN_POSITIVE, f32::NAN];
+        let random = (0..200_000).map(|_| rng.random_range(-1.2f32..1.2));
+        for x in edges.chain(special).chain(random) {
+            assert_eq!(snorm16(x), floor(x), "{x} ({:#x})", x.to_bits());
+        }
     }
 
     #[test]
