@@ -155,9 +155,18 @@ pub fn pow_ge1(x: V, e: f32) -> V {
         let f = (y - n) * std::f32::consts::LN_2;
         let q =
             (((((f * (1.0 / 720.0) + 1.0 / 120.0) * f + 1.0 / 24.0) * f + 1.0 / 6.0) * f + 0.5) * f + 1.0) * f + 1.0;
-        *r = q * f32::from_bits(((n as i32 + 127) as u32) << 23);
+        *r = q * exp2_whole(n);
     }
     V::from(r)
+}
+
+/// `2ⁿ` for a whole `n` in −126..=126, from its exponent bits: `n + 127` added to `2²³` sits
+/// in the mantissa's low bits, which the shift moves into the exponent (the bits of `2²³`
+/// shift out). The bits of `(n as i32 + 127) << 23`, whose saturating `as` stays scalar code
+/// on every lane.
+#[inline(always)]
+fn exp2_whole(n: f32) -> f32 {
+    f32::from_bits((n + (127.0 + 8_388_608.0)).to_bits() << 23)
 }
 
 /// The wind scene at sixteen points (as `wind::sample::wind_at`).
@@ -245,6 +254,14 @@ mod tests {
             } else {
                 assert!(got.length() <= len * (1.0 + 1e-6), "{v} · {len}: {got}");
             }
+        }
+    }
+
+    #[test]
+    fn exp2_whole_is_the_power_of_two() {
+        for n in -126..=126 {
+            assert_eq!(exp2_whole(n as f32), 2f32.powi(n), "2^{n}");
+            assert_eq!(exp2_whole(n as f32).to_bits(), ((n + 127) as u32) << 23, "2^{n}");
         }
     }
 
