@@ -137,6 +137,13 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         Cpu(Box<dyn Animator>),
         Gpu(&'static sylva_gpu::GpuContext, Box<dyn GpuAnimator>),
     }
+    // Building can take a while (HSM measures its own stems, `methods/hsm/calibrate.rs`: about
+    // a minute on the black oak): a spinner on the terminal says so.
+    let building = ProgressBar::new_spinner()
+        .with_message(format!("building {} on the tree", entry.name))
+        .with_finish(indicatif::ProgressFinish::AndClear);
+    building.set_style(ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("valid template"));
+    building.enable_steady_tick(std::time::Duration::from_millis(200));
     let mut sim = match a.backend {
         Backend::Cpu => {
             let mut m = (entry.cpu)(tree.clone(), &options).map_err(built)?;
@@ -145,7 +152,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         }
         Backend::Gpu => {
             let ctx = sylva_gpu::GpuContext::shared()?;
-            println!("GPU: {}", ctx.summary);
+            building.suspend(|| println!("GPU: {}", ctx.summary));
             let build = entry.gpu.with_context(|| format!("method `{}` has no GPU twin", entry.name))?;
             let gpu_wind = sylva_gpu::wind::GpuWind::from_scene(ctx, &wind)?;
             let m = build(ctx, tree.clone(), &options, &gpu_wind, &[]).map_err(|e| match e {
@@ -155,6 +162,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
             Sim::Gpu(ctx, m)
         }
     };
+    building.finish_and_clear();
     let (particles, clusters) = match &sim {
         Sim::Cpu(m) => (m.particles(), m.cluster_centres().map(|c| c.len())),
         Sim::Gpu(ctx, m) => (m.particles(), m.cluster_centres(ctx)?.map(|c| c.len())),
