@@ -6,7 +6,8 @@
 //! - **pluck**: a steady 6 m/s wind, then still air; the trunk top's sway frequency (crossings
 //!   of rest while above 5 % of the release) and damping ratio (logarithmic decrement) as it rings down;
 //! - **step response** at 3, 6, 10 and 15 m/s: the lean (mean downwind bend of the trunk
-//!   top, % of height) and the damping ratio of the ringing about it;
+//!   top, % of height) and the damping ratio of its ring, the run less the same wind switched
+//!   on a step's length earlier (what rides on the ring in a steady wind cancels);
 //! - **gusty** (the `gusty` preset, 6 m/s mean): the trunk top's sway (standard deviation of
 //!   its horizontal motion, % of height) and, per stem level, the share of the tips' motion
 //!   relative to their attachment, in the frame of the segment they grow from (the parent's
@@ -385,8 +386,9 @@ fn report(rows: &[Row], near: &[NeighbourRow], methods: &[String], args: &Fideli
         );
     }
     s += "\nA dash: the run did not ring down (fewer than three crossings, or fewer than three peaks above \
-          5 % of the largest, or peaks that do not decay as one exponential: fit R² under 0.7). A stateless \
-          method's damping ratio reads the envelope of its noise bands, not a ring-down.\n";
+          5 % of the largest, or peaks that do not decay as one exponential: fit R² under 0.7). A step \
+          response's ring is the run less the same wind switched on a step's length earlier, so what rides on \
+          the ring in a steady wind (Zioma's small-branch chaos) cancels.\n";
     s += "\n## Neighbours\n\n";
     s += "Each species' reference tree and copies of it across the mean wind and downwind, each simulated on \
           its own in `gusty`: the correlation of the trunk tops' downwind motion. Field expectation: it falls with \
