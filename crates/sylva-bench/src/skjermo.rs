@@ -23,7 +23,7 @@ use plotters::style::RGBColor;
 use serde::Serialize;
 use std::path::PathBuf;
 use sylva_core::methods::Method;
-use sylva_core::methods::skjermo::lanes::{StateLanes, StemLanes};
+use sylva_core::methods::skjermo::lanes::{OscLanes, StateLanes, StemLanes, SwayLanes};
 use sylva_core::methods::skjermo::{RawSkjermoState, RawSkjermoStem, Skjermo, SkjermoParams};
 use sylva_core::wind::WindScene;
 use sylva_core::{Grammar, LSystemOptions};
@@ -80,9 +80,14 @@ pub(crate) fn run(env: &Env<'_>) -> Result<Vec<PathBuf>> {
         let m = Skjermo::new(&tree, SkjermoParams::default());
         let n = tree.stems.len();
         // Per stem: its constants and its and its parent's previous state read, its next
-        // state written.
+        // state written; on the CPU also its bend oscillator's coefficients read and its
+        // oscillator read and written in place.
         let bytes = n * (std::mem::size_of::<RawSkjermoStem>() + 3 * std::mem::size_of::<RawSkjermoState>());
-        let cpu_bytes = m.lanes.len() * (std::mem::size_of::<StemLanes>() + 3 * std::mem::size_of::<StateLanes>());
+        let cpu_bytes = m.lanes.len()
+            * (std::mem::size_of::<StemLanes>()
+                + std::mem::size_of::<OscLanes>()
+                + 3 * std::mem::size_of::<StateLanes>()
+                + 2 * std::mem::size_of::<SwayLanes>());
         let (cpu, cpu_published, cpu_reference) = if env.time_cpu {
             let mut state = m.rest_state(&tree);
             let fast = measure(env.budget, |k| {

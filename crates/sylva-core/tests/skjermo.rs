@@ -185,8 +185,51 @@ fn the_lane_path_matches_the_reference_kernel() {
                 }
             }
             assert!(moved > 10.0 * tol, "{wname} {}: the wind should move the tree ({moved})", p.name);
+            // The bend oscillators (updated in place on the lanes, ping-pong in the reference).
+            let v = |a: &[f32; 4]| Vec3::from_slice(&a[..3]);
+            let (mut bent, mut worst_rate) = (0.0f32, 0.0f32);
+            for (k, (a, b)) in fast.sway.iter().zip(&slow.sway).enumerate() {
+                bent = bent.max(v(&b.bend).length());
+                assert!((v(&a.bend) - v(&b.bend)).length() <= tol, "{wname} {} stem {k} bend", p.name);
+                worst_rate = worst_rate.max((v(&a.rate) - v(&b.rate)).length());
+            }
+            assert!(bent > 10.0 * tol, "{wname} {}: the oscillators should move ({bent})", p.name);
+            // A rate is a bend's difference over a step: 60 × the bend's tolerance.
+            assert!(worst_rate <= 60.0 * tol, "{wname} {}: rates differ by {worst_rate}", p.name);
         }
     }
+}
+
+/// The published form (eq. 16 as printed: the bend follows the wind at once) never touches
+/// the bend oscillators, which the lane step updates in place: after 120 steps of `gusty`
+/// they are at rest on both paths while the tree has moved, and the lane path matches the
+/// reference within the same tolerance as the default form's.
+#[test]
+fn the_published_form_leaves_the_bend_oscillators_at_rest() {
+    let fw = WindScene::resolve("gusty").unwrap().packed();
+    let t = tree("quaking_aspen");
+    let m = Skjermo::new(&t, SkjermoParams { dynamics: false, ..SkjermoParams::default() });
+    let mut fast = m.rest_state(&t);
+    let mut slow = m.rest_state(&t);
+    for _ in 0..120 {
+        m.step(&t, &fw, &mut fast, 1.0 / 60.0);
+        m.step_reference(&fw.fields, &fw.waves, &mut slow, 1.0 / 60.0);
+    }
+    let zero = |a: &[f32; 4]| a.iter().all(|&x| x == 0.0);
+    assert!(fast.sway.iter().chain(&slow.sway).all(|s| zero(&s.bend) && zero(&s.rate)));
+    assert!(fast.sway_lanes.iter().all(|g| {
+        [g.bend, g.rate].iter().all(|v| [v.x, v.y, v.z].iter().all(|c| c.to_array().iter().all(|&x| x == 0.0)))
+    }));
+    let tol = 1e-5 * t.height();
+    let mut moved = 0.0f32;
+    for (a, b) in fast.stems.iter().zip(&slow.stems) {
+        for j in 0..4 {
+            let (da, db) = (Vec3::from_slice(&a.delta[j][..3]), Vec3::from_slice(&b.delta[j][..3]));
+            moved = moved.max(db.length());
+            assert!((da - db).length() <= tol, "P{j}: {da} vs {db}");
+        }
+    }
+    assert!(moved > 10.0 * tol, "the wind should move the tree ({moved})");
 }
 
 /// The lane step compiled for AVX2 (run where the CPU has it) and for the baseline x86-64
@@ -195,14 +238,15 @@ fn the_lane_path_matches_the_reference_kernel() {
 /// a CPU without AVX2 only the baseline runs, and the test says so.
 #[test]
 fn every_instruction_set_level_gives_the_same_bits() {
-    use sylva_core::methods::skjermo::lanes::{StateLanes, coefficients, step};
+    use sylva_core::methods::skjermo::lanes::{StateLanes, SwayLanes, coefficients, step};
     use sylva_core::simd::{Level, detected};
     if detected() == Level::Baseline {
         println!("this CPU has no AVX2: only the baseline level runs");
     }
-    let bits = |s: &[StateLanes]| -> Vec<u32> {
+    let bits = |s: &[StateLanes], o: &[SwayLanes]| -> Vec<u32> {
         s.iter()
-            .flat_map(|g| g.delta.iter().chain([&g.bend, &g.rate]).flat_map(|v| [v.x, v.y, v.z]))
+            .zip(o)
+            .flat_map(|(g, o)| g.delta.iter().chain([&o.bend, &o.rate]).flat_map(|v| [v.x, v.y, v.z]))
             .flat_map(|v| v.to_array().map(f32::to_bits))
             .collect()
     };
@@ -212,15 +256,16 @@ fn every_instruction_set_level_gives_the_same_bits() {
             let t = SpeciesSource::from_preset(p).unwrap().generate(4, &Default::default(), None).unwrap();
             let m = Skjermo::new(&t, SkjermoParams::default());
             let run = |level: Level| {
-                let mut s = m.rest_state(&t).lanes;
+                let rest = m.rest_state(&t);
+                let (mut s, mut sway) = (rest.lanes, rest.sway_lanes);
                 let mut next = s.clone();
                 let cs = coefficients(&m.lanes, 1.0 / 60.0);
                 for k in 1..=200 {
                     let at = m.lane_step(k as f32 / 60.0, 1.0 / 60.0);
-                    step(level, &fw.fields, &fw.waves, &m.lanes, &cs, &s, at, &mut next);
+                    step(level, &fw.fields, &fw.waves, &m.lanes, &cs, &s, &mut sway, at, &mut next);
                     std::mem::swap(&mut s, &mut next);
                 }
-                bits(&s)
+                bits(&s, &sway)
             };
             let base = run(Level::Baseline);
             assert!(base.iter().any(|&b| f32::from_bits(b) != 0.0), "{wind} {}: nothing moved", p.name);
@@ -234,7 +279,7 @@ fn every_instruction_set_level_gives_the_same_bits() {
 /// no out-of-bounds read, and the same bits as the same group with `NONE` parents.
 #[test]
 fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
-    use sylva_core::methods::skjermo::lanes::{StateLanes, coefficients, step};
+    use sylva_core::methods::skjermo::lanes::{StateLanes, SwayLanes, coefficients, step};
     use sylva_core::model::NONE;
     use sylva_core::simd::{Level, detected};
     let t = tree("quaking_aspen");
@@ -250,21 +295,24 @@ fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
             n.parent[l] = NONE;
         }
     }
-    let bits = |s: &[StateLanes]| -> Vec<u32> {
+    let bits = |s: &[StateLanes], o: &[SwayLanes]| -> Vec<u32> {
         s.iter()
-            .flat_map(|g| g.delta.iter().chain([&g.bend, &g.rate]).flat_map(|v| [v.x, v.y, v.z]))
+            .zip(o)
+            .flat_map(|(g, o)| g.delta.iter().chain([&o.bend, &o.rate]).flat_map(|v| [v.x, v.y, v.z]))
             .flat_map(|v| v.to_array().map(f32::to_bits))
             .collect()
     };
     let run = |lanes: &[_], level: Level| {
-        let mut s = m.rest_state(&t).lanes;
+        let rest = m.rest_state(&t);
+        let (mut s, mut sway) = (rest.lanes, rest.sway_lanes);
         let mut next = s.clone();
         let cs = coefficients(lanes, 1.0 / 60.0);
         for k in 1..=20 {
-            step(level, &fw.fields, &fw.waves, lanes, &cs, &s, m.lane_step(k as f32 / 60.0, 1.0 / 60.0), &mut next);
+            let at = m.lane_step(k as f32 / 60.0, 1.0 / 60.0);
+            step(level, &fw.fields, &fw.waves, lanes, &cs, &s, &mut sway, at, &mut next);
             std::mem::swap(&mut s, &mut next);
         }
-        bits(&s)
+        bits(&s, &sway)
     };
     let want = run(&none, Level::Baseline);
     assert_ne!(want, run(&m.lanes, Level::Baseline), "the edit should change the result");

@@ -142,18 +142,15 @@ pub fn coefficients(stems: &[StemLanes], dt: f32) -> Vec<OscLanes> {
         .collect()
 }
 
-/// Per-group state of sixteen stems: control-point displacements and bend oscillators. In
-/// memory eighteen lanes-of-sixteen, component after component (`delta[0].x` … `delta[3].z`,
-/// then `bend`, `rate`), which the AVX2 gather relies on.
+/// Per-group displacements of sixteen stems' control points from rest, in memory twelve
+/// lanes-of-sixteen, component after component (`delta[0].x` … `delta[3].z`), which the AVX2
+/// gather relies on. Children read their parents' from the previous step, so the step
+/// writes them to a second buffer.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[repr(C)]
 pub struct StateLanes {
     /// Displacements of P0..P3 from rest.
     pub delta: [V3; 4],
-    /// The tip's bend vector b₃, m.
-    pub bend: V3,
-    /// Its rate of change, m/s.
-    pub rate: V3,
 }
 
 impl StateLanes {
@@ -161,6 +158,18 @@ impl StateLanes {
     pub fn delta(&self, lane: usize, j: usize) -> Vec3 {
         self.delta[j].lane(lane)
     }
+}
+
+/// Per-group bend oscillators of sixteen stems. Only a stem's own step reads its oscillator,
+/// so the step updates them in place: a second buffer would cost their cache lines' reads
+/// for ownership on every step (the step is bound by memory traffic at the larger sizes).
+/// The published form leaves them at rest.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SwayLanes {
+    /// The tip's bend vector b₃, m.
+    pub bend: V3,
+    /// Its rate of change, m/s.
+    pub rate: V3,
 }
 
 /// Builds the lane groups from the reference's per-stem constants. Returns the groups and
@@ -206,13 +215,13 @@ pub fn build(stems: &[RawSkjermoStem], modes: &[RawSkjermoMode]) -> (Vec<StemLan
             damping: V::from(ks.map(|k| k.map_or(0.0, |k| modes[k].damping))),
             aero: V::from(ks.map(|k| k.map_or(0.0, |k| modes[k].aero))),
         });
-        state.push(StateLanes { delta: [V3::ZERO; 4], bend: V3::ZERO, rate: V3::ZERO });
+        state.push(StateLanes { delta: [V3::ZERO; 4] });
     }
     (lanes, state)
 }
 
 /// Floats in one [`StateLanes`].
-const STATE_FLOATS: usize = 18 * LANES;
+const STATE_FLOATS: usize = 12 * LANES;
 const _: () = assert!(std::mem::size_of::<StateLanes>() == STATE_FLOATS * 4);
 
 /// Gathers the parents' previous displacements for the sixteen lanes of a group (a trunk or
@@ -251,10 +260,9 @@ fn gather_avx2(parent: &[u32; LANES], prev: &[StateLanes]) -> [V3; 4] {
     for h in 0..2 {
         // SAFETY: AVX2 is enabled for this function. `parent` holds sixteen u32, read as two
         // unaligned halves of eight. A lane is gathered only where its parent is at most
-        // `last`, so its index `(p / 16) · 288 + p % 16 + 16 · component` lies inside `prev`
-        // (`prev` is `repr(C)`, eighteen lanes-of-sixteen per group, of which the first
-        // twelve, the displacements, are read); other lanes keep `c`'s defaults. Stores go to
-        // `c`'s arrays, eight floats at offset 0 or 8.
+        // `last`, so its index `(p / 16) · 192 + p % 16 + 16 · component` lies inside `prev`
+        // (`prev` is `repr(C)`, twelve lanes-of-sixteen per group); other lanes keep `c`'s
+        // defaults. Stores go to `c`'s arrays, eight floats at offset 0 or 8.
         unsafe {
             let p = _mm256_loadu_si256(parent.as_ptr().add(8 * h).cast());
             let inside = _mm256_cmpeq_epi32(_mm256_min_epu32(p, _mm256_set1_epi32(last)), p);
@@ -307,8 +315,9 @@ pub struct LaneStep {
 }
 
 /// One step for every group: re-attach on the parents' previous curves, sample the wind at
-/// the tips, advance the bend oscillators (`coefficients`: [`coefficients`] for `step.dt`),
-/// bend P2 and P3 (eqs. 15–17). Same step as `kernels::skjermo_step`.
+/// the tips, advance the bend oscillators `sway` in place (`coefficients`: [`coefficients`]
+/// for `step.dt`; untouched in the published form), bend P2 and P3 (eqs. 15–17). Same step
+/// as `kernels::skjermo_step`.
 /// `level`: the instruction set to run on, [`crate::simd::level`] for the CPU's best (every
 /// level gives the same bits).
 #[allow(clippy::too_many_arguments)]
@@ -319,25 +328,28 @@ pub fn step(
     stems: &[StemLanes],
     coefficients: &[OscLanes],
     prev: &[StateLanes],
+    sway: &mut [SwayLanes],
     step: LaneStep,
     next: &mut [StateLanes],
 ) {
     assert_eq!(coefficients.len(), stems.len(), "skjermo_lanes::step: oscillator coefficients per group");
     assert!(
-        prev.len() == stems.len() && next.len() == stems.len(),
-        "skjermo_lanes::step: {} stem groups, {} and {} state groups",
+        prev.len() == stems.len() && next.len() == stems.len() && sway.len() == stems.len(),
+        "skjermo_lanes::step: {} stem groups, {} and {} state groups, {} oscillator groups",
         stems.len(),
         prev.len(),
-        next.len()
+        next.len(),
+        sway.len()
     );
     // The AVX2 gather indexes `prev` in floats with i32.
     let fast_gather =
         level.min(crate::simd::detected()) == Level::Avx2 && prev.len() * STATE_FLOATS <= i32::MAX as usize;
-    next.par_chunks_mut(16).zip(stems.par_chunks(16)).enumerate().for_each(|(c, (out, st))| {
-        let own = &prev[16 * c..16 * c + out.len()];
-        let cs = &coefficients[16 * c..16 * c + out.len()];
-        groups_at(level, fields, waves, st, cs, prev, own, step, fast_gather, out);
-    });
+    next.par_chunks_mut(16).zip(sway.par_chunks_mut(16)).zip(stems.par_chunks(16)).enumerate().for_each(
+        |(c, ((out, sw), st))| {
+            let cs = &coefficients[16 * c..16 * c + out.len()];
+            groups_at(level, fields, waves, st, cs, prev, sw, step, fast_gather, out);
+        },
+    );
 }
 
 dispatch! {
@@ -350,12 +362,12 @@ fn groups_at(
     stems: &[StemLanes],
     coefficients: &[OscLanes],
     prev: &[StateLanes],
-    own: &[StateLanes],
+    sway: &mut [SwayLanes],
     step: LaneStep,
     fast_gather: bool,
     next: &mut [StateLanes],
 ) {
-    for (((out, st), cs), was) in next.iter_mut().zip(stems).zip(coefficients).zip(own) {
+    for (((out, st), cs), osc) in next.iter_mut().zip(stems).zip(coefficients).zip(sway) {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: `fast_gather` is set only at the AVX2 level, which `step` runs only where
         // the CPU has AVX2.
@@ -406,15 +418,13 @@ fn groups_at(
         let push = V3::select(pushed, w.scale(cu), V3::ZERO);
         let b3 = if step.dynamics {
             // `physics::oscillator::damped_apply`, lane by lane, then the air's damping.
-            let x = was.bend.sub(push);
-            let bend = push.add(x.scale(cs.c)).add(was.rate.add(x.scale(st.damping)).scale(cs.s));
-            let rate = was.rate.scale(cs.c).sub(was.rate.scale(st.damping).add(x.scale(st.w2)).scale(cs.s));
-            out.bend = bend;
-            out.rate = rate.scale(V::ONE / (V::ONE + st.aero * u * g * V::splat(step.dt)));
+            let x = osc.bend.sub(push);
+            let bend = push.add(x.scale(cs.c)).add(osc.rate.add(x.scale(st.damping)).scale(cs.s));
+            let rate = osc.rate.scale(cs.c).sub(osc.rate.scale(st.damping).add(x.scale(st.w2)).scale(cs.s));
+            osc.bend = bend;
+            osc.rate = rate.scale(V::ONE / (V::ONE + st.aero * u * g * V::splat(step.dt)));
             bend
         } else {
-            out.bend = V3::ZERO;
-            out.rate = V3::ZERO;
             push
         };
         let bend = b3.dot(b3).cmp_gt(V::ZERO);

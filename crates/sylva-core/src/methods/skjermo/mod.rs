@@ -50,7 +50,7 @@ pub mod raw;
 
 pub use raw::*;
 
-use self::lanes::{LANES, LaneStep, OscLanes, StateLanes, StemLanes};
+use self::lanes::{LANES, LaneStep, OscLanes, StateLanes, StemLanes, SwayLanes};
 use super::{Animator, Method, MethodError, MethodOptions, Simulation, check};
 use crate::leaves::LeafFlutter;
 use crate::model::{NONE, Tree};
@@ -143,10 +143,13 @@ pub struct SkjermoState {
     pub pose: Pose,
     /// Accumulated rotations D of the current pose (the seam's buffer).
     pub acc: Vec<[f32; 4]>,
-    /// The per-stem state in groups of sixteen (what the CPU step reads and writes; `stems`
-    /// is copied from it after every step).
+    /// The per-stem displacements in groups of sixteen (what the CPU step reads and writes;
+    /// `stems` is copied from it after every step).
     pub lanes: Vec<StateLanes>,
     scratch: Vec<StateLanes>,
+    /// The bend oscillators in groups of sixteen (the CPU step updates them in place; `sway`
+    /// is copied from them after every step).
+    pub sway_lanes: Vec<SwayLanes>,
     /// The oscillators' step coefficients per group for the step length `.0`.
     coefficients: (f32, Vec<OscLanes>),
 }
@@ -336,6 +339,7 @@ impl Skjermo {
             &self.lanes,
             &state.coefficients.1,
             &state.lanes,
+            &mut state.sway_lanes,
             self.lane_step(t, dt),
             &mut state.scratch,
         );
@@ -423,6 +427,7 @@ impl Method for Skjermo {
             acc: vec![[0.0, 0.0, 0.0, 1.0]; tree.segments.len()],
             lanes: self.rest_lanes.clone(),
             scratch: self.rest_lanes.clone(),
+            sway_lanes: vec![SwayLanes::default(); self.rest_lanes.len()],
             coefficients: (0.0, Vec::new()),
         }
     }
@@ -431,14 +436,14 @@ impl Method for Skjermo {
     /// bend (ping-pong, sixteen stems at a time), then the pose follows.
     fn step(&self, tree: &Tree, wind: &PackedWind, state: &mut SkjermoState, dt: f32) {
         self.step_stems(&wind.fields, &wind.waves, state, dt);
-        let lanes = &state.lanes;
+        let (lanes, sway) = (&state.lanes, &state.sway_lanes);
         state.stems.par_iter_mut().zip(state.sway.par_iter_mut()).enumerate().for_each(|(k, (s, sw))| {
-            let g = &lanes[k / LANES];
+            let (g, o) = (&lanes[k / LANES], &sway[k / LANES]);
             let l = k % LANES;
             *s = RawSkjermoState { delta: [0, 1, 2, 3].map(|j| g.delta(l, j).extend(0.0).to_array()) };
             *sw = RawSkjermoSway {
-                bend: g.bend.lane(l).extend(0.0).to_array(),
-                rate: g.rate.lane(l).extend(0.0).to_array(),
+                bend: o.bend.lane(l).extend(0.0).to_array(),
+                rate: o.rate.lane(l).extend(0.0).to_array(),
             };
         });
         self.update_pose(tree, state);
