@@ -3,7 +3,8 @@
 use glam::Vec3;
 use sylva_core::Tree;
 use sylva_core::methods::Method;
-use sylva_core::methods::skjermo::{Skjermo, SkjermoParams};
+use sylva_core::methods::skjermo::lanes::{StateLanes, SwayLanes};
+use sylva_core::methods::skjermo::{Skjermo, SkjermoParams, SkjermoState};
 use sylva_core::pose::{Pose, displacement};
 use sylva_core::species::{PRESETS, SpeciesSource};
 use sylva_core::wind::{Constant, WindField, WindScene};
@@ -176,15 +177,7 @@ fn the_lane_path_matches_the_reference_kernel() {
                 m.step_reference(&fw.fields, &fw.waves, &mut slow, 1.0 / 60.0);
             }
             let tol = 1e-5 * t.height();
-            let mut moved = 0.0f32;
-            for (k, (a, b)) in fast.stems.iter().zip(&slow.stems).enumerate() {
-                for j in 0..4 {
-                    let (da, db) = (Vec3::from_slice(&a.delta[j][..3]), Vec3::from_slice(&b.delta[j][..3]));
-                    moved = moved.max(db.length());
-                    assert!((da - db).length() <= tol, "{wname} {} stem {k} P{j}: {da} vs {db}", p.name);
-                }
-            }
-            assert!(moved > 10.0 * tol, "{wname} {}: the wind should move the tree ({moved})", p.name);
+            curves_match(&fast, &slow, tol, &format!("{wname} {}", p.name));
             // The bend oscillators (updated in place on the lanes, ping-pong in the reference).
             let v = |a: &[f32; 4]| Vec3::from_slice(&a[..3]);
             let (mut bent, mut worst_rate) = (0.0f32, 0.0f32);
@@ -215,21 +208,33 @@ fn the_published_form_leaves_the_bend_oscillators_at_rest() {
         m.step(&t, &fw, &mut fast, 1.0 / 60.0);
         m.step_reference(&fw.fields, &fw.waves, &mut slow, 1.0 / 60.0);
     }
-    let zero = |a: &[f32; 4]| a.iter().all(|&x| x == 0.0);
-    assert!(fast.sway.iter().chain(&slow.sway).all(|s| zero(&s.bend) && zero(&s.rate)));
-    assert!(fast.sway_lanes.iter().all(|g| {
-        [g.bend, g.rate].iter().all(|v| [v.x, v.y, v.z].iter().all(|c| c.to_array().iter().all(|&x| x == 0.0)))
-    }));
-    let tol = 1e-5 * t.height();
+    let rest = m.rest_state(&t);
+    assert!(fast.sway == rest.sway && slow.sway == rest.sway && fast.sway_lanes == rest.sway_lanes);
+    curves_match(&fast, &slow, 1e-5 * t.height(), "the published form");
+}
+
+/// Asserts that the lane path's control-point displacements (`fast`) are within `tol` of
+/// the reference kernel's (`slow`), and that the wind moved the reference by more than ten
+/// times that.
+fn curves_match(fast: &SkjermoState, slow: &SkjermoState, tol: f32, what: &str) {
     let mut moved = 0.0f32;
-    for (a, b) in fast.stems.iter().zip(&slow.stems) {
+    for (k, (a, b)) in fast.stems.iter().zip(&slow.stems).enumerate() {
         for j in 0..4 {
             let (da, db) = (Vec3::from_slice(&a.delta[j][..3]), Vec3::from_slice(&b.delta[j][..3]));
             moved = moved.max(db.length());
-            assert!((da - db).length() <= tol, "P{j}: {da} vs {db}");
+            assert!((da - db).length() <= tol, "{what} stem {k} P{j}: {da} vs {db}");
         }
     }
-    assert!(moved > 10.0 * tol, "the wind should move the tree ({moved})");
+    assert!(moved > 10.0 * tol, "{what}: the wind should move the tree ({moved})");
+}
+
+/// Every bit of the lane groups' state: displacements and oscillators.
+fn lane_bits(s: &[StateLanes], o: &[SwayLanes]) -> Vec<u32> {
+    s.iter()
+        .zip(o)
+        .flat_map(|(g, o)| g.delta.iter().chain([&o.bend, &o.rate]).flat_map(|v| [v.x, v.y, v.z]))
+        .flat_map(|v| v.to_array().map(f32::to_bits))
+        .collect()
 }
 
 /// The lane step compiled for AVX2 (run where the CPU has it) and for the baseline x86-64
@@ -238,18 +243,11 @@ fn the_published_form_leaves_the_bend_oscillators_at_rest() {
 /// a CPU without AVX2 only the baseline runs, and the test says so.
 #[test]
 fn every_instruction_set_level_gives_the_same_bits() {
-    use sylva_core::methods::skjermo::lanes::{StateLanes, SwayLanes, coefficients, step};
+    use sylva_core::methods::skjermo::lanes::{coefficients, step};
     use sylva_core::simd::{Level, detected};
     if detected() == Level::Baseline {
         println!("this CPU has no AVX2: only the baseline level runs");
     }
-    let bits = |s: &[StateLanes], o: &[SwayLanes]| -> Vec<u32> {
-        s.iter()
-            .zip(o)
-            .flat_map(|(g, o)| g.delta.iter().chain([&o.bend, &o.rate]).flat_map(|v| [v.x, v.y, v.z]))
-            .flat_map(|v| v.to_array().map(f32::to_bits))
-            .collect()
-    };
     for wind in ["gusty", "blast"] {
         let fw = WindScene::resolve(wind).unwrap().packed();
         for p in PRESETS {
@@ -265,7 +263,7 @@ fn every_instruction_set_level_gives_the_same_bits() {
                     step(level, &fw.fields, &fw.waves, &m.lanes, &cs, &s, &mut sway, at, &mut next);
                     std::mem::swap(&mut s, &mut next);
                 }
-                bits(&s, &sway)
+                lane_bits(&s, &sway)
             };
             let base = run(Level::Baseline);
             assert!(base.iter().any(|&b| f32::from_bits(b) != 0.0), "{wind} {}: nothing moved", p.name);
@@ -279,7 +277,7 @@ fn every_instruction_set_level_gives_the_same_bits() {
 /// no out-of-bounds read, and the same bits as the same group with `NONE` parents.
 #[test]
 fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
-    use sylva_core::methods::skjermo::lanes::{StateLanes, SwayLanes, coefficients, step};
+    use sylva_core::methods::skjermo::lanes::{coefficients, step};
     use sylva_core::model::NONE;
     use sylva_core::simd::{Level, detected};
     let t = tree("quaking_aspen");
@@ -295,13 +293,6 @@ fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
             n.parent[l] = NONE;
         }
     }
-    let bits = |s: &[StateLanes], o: &[SwayLanes]| -> Vec<u32> {
-        s.iter()
-            .zip(o)
-            .flat_map(|(g, o)| g.delta.iter().chain([&o.bend, &o.rate]).flat_map(|v| [v.x, v.y, v.z]))
-            .flat_map(|v| v.to_array().map(f32::to_bits))
-            .collect()
-    };
     let run = |lanes: &[_], level: Level| {
         let rest = m.rest_state(&t);
         let (mut s, mut sway) = (rest.lanes, rest.sway_lanes);
@@ -312,7 +303,7 @@ fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
             step(level, &fw.fields, &fw.waves, lanes, &cs, &s, &mut sway, at, &mut next);
             std::mem::swap(&mut s, &mut next);
         }
-        bits(&s, &sway)
+        lane_bits(&s, &sway)
     };
     let want = run(&none, Level::Baseline);
     assert_ne!(want, run(&m.lanes, Level::Baseline), "the edit should change the result");
