@@ -257,7 +257,7 @@ fn every_instruction_set_level_gives_the_same_bits() {
                 let rest = m.rest_state(&t);
                 let (mut s, mut sway) = (rest.lanes, rest.sway_lanes);
                 let mut next = s.clone();
-                let cs = coefficients(&m.lanes, 1.0 / 60.0);
+                let cs = coefficients(&m.modes, 1.0 / 60.0);
                 for k in 1..=200 {
                     let at = m.lane_step(k as f32 / 60.0, 1.0 / 60.0);
                     step(level, &fw.fields, &fw.waves, &m.lanes, &cs, &s, &mut sway, at, &mut next);
@@ -297,7 +297,7 @@ fn a_parent_outside_the_state_is_read_as_none_at_every_level() {
         let rest = m.rest_state(&t);
         let (mut s, mut sway) = (rest.lanes, rest.sway_lanes);
         let mut next = s.clone();
-        let cs = coefficients(lanes, 1.0 / 60.0);
+        let cs = coefficients(&m.modes, 1.0 / 60.0);
         for k in 1..=20 {
             let at = m.lane_step(k as f32 / 60.0, 1.0 / 60.0);
             step(level, &fw.fields, &fw.waves, lanes, &cs, &s, &mut sway, at, &mut next);

@@ -3,24 +3,31 @@
 //! `kernels::skjermo_step` is the reference (the twin of `skjermo_step.wgsl`, one stem per
 //! invocation). This module computes the same step on groups of sixteen stems held as
 //! structure-of-arrays lanes ([`crate::simd::F32x16`]). At the larger sizes the step is bound
-//! by memory traffic, so a group keeps only what cannot be recomputed cheaply (112 bytes of
-//! constants per stem, 12 of them the bend oscillator's, against the reference's 160 + 16)
+//! by memory traffic, so a group keeps only what cannot be recomputed cheaply (124 bytes of
+//! constants per stem, 20 of them the bend oscillator's, against the reference's 160 + 16)
 //! and derives the rest:
 //!
 //! * the parent's curve enters only through its displacement from rest, because a Bézier is
 //!   linear in its control points: `B(P_rest + Δ, a) = B(P_rest, a) + B(Δ, a)`, so the shift of
 //!   the attachment point is `Σ Bⱼ(a) Δⱼ` and the tangent is the rest tangent plus `B'(Δ, a)`,
-//!   both with weights computed from the stored attachment parameter `a`;
+//!   both with weights computed from the stored attachment parameter `a` (the tangent's in
+//!   units of the rest tangent's length, so that the unit rest tangent is stored rather than
+//!   recomputed);
 //! * every control point moves by `shift + (F_now − F_rest) · local`, which is exactly zero
 //!   when nothing moved, so still air still reproduces the rest curves bit for bit. Of the
-//!   rest frame only the normal is stored: its tangent and binormal are recomputed by the
-//!   same instructions that built them;
+//!   rest frame the tangent and normal are stored, the binormal recomputed by the same
+//!   instructions that built it; the frame now is the rest frame turned by the shortest arc,
+//!   without the reference's re-orthonormalisation (exact in exact arithmetic; every step
+//!   turns the rest frame afresh, so rounding does not build up);
 //! * the legs P1→P2 and P2→P3 are the local legs turned by the current frame, so of the rest
 //!   control points only the tip (where the wind is sampled) is stored;
 //! * `p2_weight^exponent` is computed once per step, not once per stem, and the bend
-//!   oscillators' step coefficients once per step length ([`coefficients`]);
+//!   oscillators' step coefficients, folded with their ω² and ζω, once per step length
+//!   ([`coefficients`]);
 //! * reconfiguration's power `(1 + (u/U_r)²)^(B/2)` by polynomials ([`pow_ge1`]), not a library
-//!   call per lane;
+//!   call per lane, from `u²` (no division by `U_r`);
+//! * each leg is kept at its length by one square root of the ratio of squared lengths
+//!   (`turned`), not two;
 //! * the parents' state is fetched with AVX2's gather instruction where the CPU has it.
 //!
 //! The wind is sampled on all sixteen lanes at once ([`crate::wind::lanes`]: a polynomial sine,
@@ -36,6 +43,7 @@ pub use crate::wind::lanes::LANES;
 pub use crate::wind::lanes::pow_ge1;
 use crate::wind::lanes::{V, V3, wind_lanes};
 use crate::wind::raw::{RawField, RawWave};
+use bytemuck::Zeroable;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::ops::{Add, Sub};
@@ -63,21 +71,30 @@ fn unit_normal(n: V3, tan: V3) -> V3 {
 }
 
 /// The attachment frame now, as `methods::skjermo::transported_frame`: the rest frame
-/// (`t_rest`, `n_rest`) turned by the shortest arc to the parent curve's `tangent`; the rest
-/// frame itself in lanes whose tangent is the rest one.
+/// (`t_rest`, `n_rest`, `b_rest`) turned by the shortest arc to the parent curve's `tangent`
+/// (in units of the rest tangent's length); the rest frame itself, bit for bit, in lanes whose
+/// tangent is the rest one. Where every lane turns by less than half a turn the turned normal
+/// is used as it is: it is unit and normal to the tangent but for rounding, which does not
+/// build up (every step turns the rest frame afresh), so the reference's re-orthonormalisation
+/// is left out.
 #[inline(always)]
-fn transported_frame(t_rest: V3, n_rest: V3, tangent: V3) -> [V3; 3] {
-    let t = unit_tangent(tangent);
-    let same = t.x.cmp_eq(t_rest.x) & t.y.cmp_eq(t_rest.y) & t.z.cmp_eq(t_rest.z);
+fn transported_frame(t_rest: V3, n_rest: V3, b_rest: V3, tangent: V3) -> [V3; 3] {
+    let same = tangent.x.cmp_eq(t_rest.x) & tangent.y.cmp_eq(t_rest.y) & tangent.z.cmp_eq(t_rest.z);
     if same.all() {
-        return [t_rest, n_rest, t_rest.cross(n_rest)];
+        return [t_rest, n_rest, b_rest];
     }
+    let t = unit_tangent(tangent);
     let (k, c) = (t_rest.cross(t), t_rest.dot(t));
     let one_c = V::ONE + c;
     let turning = one_c.cmp_gt(V::splat(1e-6));
-    let turned = n_rest.scale(c).add(k.cross(n_rest)).add(k.scale(k.dot(n_rest) / turning.blend(one_c, V::ONE)));
-    let m = V3::select(turning, turned, n_rest);
-    let n = V3::select(same, n_rest, unit_normal(m.sub(t.scale(m.dot(t))), t));
+    let n = if turning.all() {
+        n_rest.scale(c).add(k.cross(n_rest)).add(k.scale(k.dot(n_rest) / one_c))
+    } else {
+        let turned = n_rest.scale(c).add(k.cross(n_rest)).add(k.scale(k.dot(n_rest) / turning.blend(one_c, V::ONE)));
+        let m = V3::select(turning, turned, n_rest);
+        unit_normal(m.sub(t.scale(m.dot(t))), t)
+    };
+    let n = V3::select(same, n_rest, n);
     let t = V3::select(same, t_rest, t);
     [t, n, t.cross(n)]
 }
@@ -98,10 +115,14 @@ pub struct StemLanes {
     /// Attachment parameter `a` on the parent's curve (0 for a trunk or padding lane, whose
     /// gathered parent displacements are zero).
     pub attach: V,
-    /// Rest tangent of the parent's curve at the attachment (a trunk: its own at 0).
-    pub tan_rest: V3,
-    /// Rest attachment frame's normal (its tangent is `tan_rest` normalised and its binormal
-    /// their cross product, both recomputed bit for bit).
+    /// Rest attachment frame's tangent: the unit rest tangent of the parent's curve at the
+    /// attachment (a trunk: its own at 0).
+    pub t_rest: V3,
+    /// The reciprocal of that tangent's length before it was made unit, 1/m: the parent's
+    /// curve's tangent now, in these units, is `t_rest` plus the derivative of its
+    /// displacement times this.
+    pub tan_scale: V,
+    /// Rest attachment frame's normal (its binormal, `t_rest × n_rest`, is recomputed).
     pub n_rest: V3,
     /// Control points relative to the attachment in the attachment frame.
     pub local: [V3; 4],
@@ -111,33 +132,40 @@ pub struct StemLanes {
     pub drag: V,
     /// Arc length, m.
     pub length: V,
-    /// The bend oscillator's ω², rad²/s².
-    pub w2: V,
-    /// Its structural damping rate ζω, 1/s.
-    pub damping: V,
-    /// Its aerodynamic damping per m/s of wind, 1/m.
+    /// The bend oscillator's aerodynamic damping per m/s of wind, 1/m (its other constants
+    /// are folded into [`OscLanes`]).
     pub aero: V,
 }
 
-/// The bend oscillators' step coefficients `(C, S)` of sixteen stems for one step length
-/// ([`crate::physics::oscillator::damped_coefficients`], per lane).
+/// The bend oscillators' step over one step length for sixteen stems:
+/// [`crate::physics::oscillator::damped_coefficients`]' `(C, S)` folded with the oscillator's
+/// ω² and ζω, so that the step is `b' = p + A (b − p) + S ḃ`, `ḃ' = D ḃ − E (b − p)` (`p` the
+/// push): `damped_apply`'s step, rounded differently.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OscLanes {
-    /// C.
-    pub c: V,
-    /// S.
+    /// A = C + ζω S.
+    pub a: V,
+    /// S, s.
     pub s: V,
+    /// D = C − ζω S.
+    pub d: V,
+    /// E = ω² S, 1/s.
+    pub e: V,
 }
 
-/// Each group's oscillator coefficients for steps of `dt` seconds.
-pub fn coefficients(stems: &[StemLanes], dt: f32) -> Vec<OscLanes> {
-    stems
-        .iter()
+/// Each group's oscillator coefficients for steps of `dt` seconds, from the per-stem modes
+/// (a padding lane's: a rest oscillator's).
+pub fn coefficients(modes: &[RawSkjermoMode], dt: f32) -> Vec<OscLanes> {
+    modes
+        .chunks(LANES)
         .map(|g| {
-            let (w2, a) = (g.w2.as_array_ref(), g.damping.as_array_ref());
-            let cs: [(f32, f32); LANES] =
-                std::array::from_fn(|l| crate::physics::oscillator::damped_coefficients(w2[l], a[l], dt));
-            OscLanes { c: V::from(cs.map(|x| x.0)), s: V::from(cs.map(|x| x.1)) }
+            let k: [[f32; 4]; LANES] = std::array::from_fn(|l| {
+                let m = g.get(l).copied().unwrap_or_else(RawSkjermoMode::zeroed);
+                let (c, s) = crate::physics::oscillator::damped_coefficients(m.w2, m.damping, dt);
+                [c + m.damping * s, s, c - m.damping * s, m.w2 * s]
+            });
+            let lane = |i: usize| V::from(k.map(|x| x[i]));
+            OscLanes { a: lane(0), s: lane(1), d: lane(2), e: lane(3) }
         })
         .collect()
 }
@@ -197,6 +225,8 @@ pub fn build(stems: &[RawSkjermoStem], modes: &[RawSkjermoMode]) -> (Vec<StemLan
             .map(|k| k.map_or(Vec3::X, |k| if stems[k].parent == NONE { Vec3::X } else { v(stems[k].parent_orient) }));
         let tan_rest = V3::from_lanes(tan);
         let f_rest = frame(tan_rest, V3::from_lanes(o_rest));
+        let tan_length = tan_rest.length();
+        let tan_scale = tan_length.cmp_gt(V::splat(1e-6)).blend(V::ONE / tan_length, V::ONE);
         let per =
             |f: &dyn Fn(&RawSkjermoStem) -> Vec3| V3::from_lanes(ks.map(|k| k.map_or(Vec3::ZERO, |k| f(&stems[k]))));
         let local = [0, 1, 2, 3].map(|j| per(&|s| v(s.local[j])));
@@ -205,14 +235,13 @@ pub fn build(stems: &[RawSkjermoStem], modes: &[RawSkjermoMode]) -> (Vec<StemLan
         lanes.push(StemLanes {
             parent,
             attach: V::from(attach),
-            tan_rest,
+            t_rest: f_rest[0],
+            tan_scale,
             n_rest: f_rest[1],
             local,
             rest_tip,
             drag: scalar(&|s| s.drag),
             length: scalar(&|s| s.length),
-            w2: V::from(ks.map(|k| k.map_or(0.0, |k| modes[k].w2))),
-            damping: V::from(ks.map(|k| k.map_or(0.0, |k| modes[k].damping))),
             aero: V::from(ks.map(|k| k.map_or(0.0, |k| modes[k].aero))),
         });
         state.push(StateLanes { delta: [V3::ZERO; 4] });
@@ -287,6 +316,20 @@ fn gather_avx2(parent: &[u32; LANES], prev: &[StateLanes]) -> [V3; 4] {
 #[inline(always)]
 fn moved(shift: V3, df: &[V3; 3], l: V3) -> V3 {
     shift.add(df[0].scale(l.x)).add(df[1].scale(l.y)).add(df[2].scale(l.z))
+}
+
+/// How far the end of `leg` moves when the leg is turned toward `push` and kept at its length
+/// (eq. 17): `(leg + push)` scaled to `|leg|`, less `leg`; by one square root of the squared
+/// lengths' ratio, rather than `V3::with_length`'s two (a lane whose turned leg is zero, or too
+/// short or long to square, is not turned: `-leg`, as `with_length` gives).
+#[inline(always)]
+fn turned(leg: V3, push: V3) -> V3 {
+    let v = leg.add(push);
+    let vv = v.dot(v);
+    let positive = vv.cmp_gt(V::ZERO);
+    let ratio = (leg.dot(leg) / positive.blend(vv, V::ONE)).sqrt();
+    let ok = positive & vv.is_finite() & ratio.is_finite();
+    V3::select(ok, v.scale(ratio), V3::ZERO).sub(leg)
 }
 
 /// Frame coordinates `l` as a world vector: `F · l`.
@@ -380,24 +423,24 @@ fn groups_at(
         };
         // The attachment point's shift `Σ wⱼ Δⱼ` (Bernstein weights of `a`) and the parent
         // curve's tangent there, `tan_rest + B'(Δ, a)` with `B'(Δ, a) = Σ eⱼ Δⱼ`,
-        // `e = (−3s², 3s² − 6st, 6st − 3t², 3t²)`. Computed here rather than stored: the
-        // step is bound by memory traffic at the larger sizes.
+        // `e = (−3s², 3s² − 6st, 6st − 3t², 3t²)`, in units of the rest tangent's length (the
+        // frame only needs its direction). Computed here rather than stored: the step is bound
+        // by memory traffic at the larger sizes.
         let (t, s) = (st.attach, V::ONE - st.attach);
         let (ss, st_, tt) = (s * s, s * t, t * t);
         let w = [ss * s, V::splat(3.0) * ss * t, V::splat(3.0) * s * tt, tt * t];
-        let dw = [V::splat(3.0) * ss, V::splat(6.0) * st_, V::splat(3.0) * tt];
+        let dw = [V::splat(3.0) * ss * st.tan_scale, V::splat(6.0) * st_ * st.tan_scale, V::splat(3.0) * tt * st.tan_scale];
         let e = [-dw[0], dw[0] - dw[1], dw[1] - dw[2], dw[2]];
-        let (mut shift, mut tan) = (V3::ZERO, st.tan_rest);
+        let (mut shift, mut tan) = (V3::ZERO, st.t_rest);
         for (j, dj) in dp.iter().enumerate() {
             shift = shift.add(dj.scale(w[j]));
             tan = tan.add(dj.scale(e[j]));
         }
         // Written out, not with `array::map` or a closure: neither is inlined into the AVX2
         // body, and they would run as baseline code.
-        let t_rest = unit_tangent(st.tan_rest);
-        let b_rest = t_rest.cross(st.n_rest);
-        let f_now = transported_frame(t_rest, st.n_rest, tan);
-        let df = [f_now[0].sub(t_rest), f_now[1].sub(st.n_rest), f_now[2].sub(b_rest)];
+        let b_rest = st.t_rest.cross(st.n_rest);
+        let f_now = transported_frame(st.t_rest, st.n_rest, b_rest, tan);
+        let df = [f_now[0].sub(st.t_rest), f_now[1].sub(st.n_rest), f_now[2].sub(b_rest)];
         // P0 and P1 only follow the attachment: written at once, so that fewer values stay
         // live across the wind.
         out.delta[0] = moved(shift, &df, st.local[0]);
@@ -408,19 +451,24 @@ fn groups_at(
         // Wind at the tip and the static push b₃ = c ŵ (eq. 16), which the bend follows as
         // the stem's damped first mode (or at once).
         let w = wind_lanes(fields, waves, st.rest_tip.add(d3), step.time);
-        let u = w.length();
-        let r = u / V::splat(step.reconfiguration_speed);
-        let g = if step.vogel_exponent == 0.0 { V::ONE } else { pow_ge1(V::ONE + r * r, 0.5 * step.vogel_exponent) };
-        let theta = (st.drag * u * u * g).min(V::splat(step.max_bend));
+        let uu = w.dot(w);
+        let u = uu.sqrt();
+        let g = if step.vogel_exponent == 0.0 {
+            V::ONE
+        } else {
+            let ur = step.reconfiguration_speed;
+            pow_ge1(V::ONE + uu * V::splat(1.0 / (ur * ur)), 0.5 * step.vogel_exponent)
+        };
+        let theta = (st.drag * uu * g).min(V::splat(step.max_bend));
         let c = st.length * theta;
         let pushed = u.cmp_gt(V::ZERO) & c.cmp_gt(V::ZERO);
         let cu = c / pushed.blend(u, V::ONE);
         let push = V3::select(pushed, w.scale(cu), V3::ZERO);
         let b3 = if step.dynamics {
-            // `physics::oscillator::damped_apply`, lane by lane, then the air's damping.
+            // `physics::oscillator::damped_apply` ([`OscLanes`]), then the air's damping.
             let x = osc.bend.sub(push);
-            let bend = push.add(x.scale(cs.c)).add(osc.rate.add(x.scale(st.damping)).scale(cs.s));
-            let rate = osc.rate.scale(cs.c).sub(osc.rate.scale(st.damping).add(x.scale(st.w2)).scale(cs.s));
+            let bend = push.add(x.scale(cs.a)).add(osc.rate.scale(cs.s));
+            let rate = osc.rate.scale(cs.d).sub(x.scale(cs.e));
             osc.bend = bend;
             osc.rate = rate.scale(V::ONE / (V::ONE + st.aero * u * g * V::splat(step.dt)));
             bend
@@ -436,8 +484,8 @@ fn groups_at(
         let l3 = in_frame(&f_now, st.local[3].sub(st.local[2]));
         // Each leg turned toward its push and kept at its length: P2 moves by c2, P3 by
         // c2 + c3.
-        let c2 = l2.add(b2).with_length(l2.length()).sub(l2);
-        let c3 = l3.add(b3).with_length(l3.length()).sub(l3);
+        let c2 = turned(l2, b2);
+        let c3 = turned(l3, b3);
         out.delta[2] = d2.add(V3::select(bend, c2, V3::ZERO));
         out.delta[3] = d3.add(V3::select(bend, c2.add(c3), V3::ZERO));
     }

@@ -330,7 +330,7 @@ impl Skjermo {
     pub fn step_stems(&self, fields: &[RawField], waves: &[RawWave], state: &mut SkjermoState, dt: f32) {
         let t = state.time + dt;
         if state.coefficients.0 != dt || state.coefficients.1.len() != self.lanes.len() {
-            state.coefficients = (dt, lanes::coefficients(&self.lanes, dt));
+            state.coefficients = (dt, lanes::coefficients(&self.modes, dt));
         }
         lanes::step(
             crate::simd::level(),
