@@ -87,10 +87,10 @@ fn transported_frame(t_rest: V3, n_rest: V3, b_rest: V3, tangent: V3) -> [V3; 3]
     let (k, c) = (t_rest.cross(t), t_rest.dot(t));
     let one_c = V::ONE + c;
     let turning = one_c.cmp_gt(V::splat(1e-6));
+    let turned = n_rest.scale(c).add(k.cross(n_rest)).add(k.scale(k.dot(n_rest) / turning.blend(one_c, V::ONE)));
     let n = if turning.all() {
-        n_rest.scale(c).add(k.cross(n_rest)).add(k.scale(k.dot(n_rest) / one_c))
+        turned
     } else {
-        let turned = n_rest.scale(c).add(k.cross(n_rest)).add(k.scale(k.dot(n_rest) / turning.blend(one_c, V::ONE)));
         let m = V3::select(turning, turned, n_rest);
         unit_normal(m.sub(t.scale(m.dot(t))), t)
     };
